@@ -1,0 +1,3 @@
+namespace cfdmpm {
+const char* version() { return CFDMPM_VERSION; }
+}  // namespace cfdmpm

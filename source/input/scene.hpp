@@ -1,0 +1,99 @@
+#pragma once
+// A scene: everything one run needs, read from one YAML file and validated before the first step.
+// The typed structs hold what the foundation (grid, output, time control) uses; each physics module
+// reads its own, already validated, sublist from `parameters`.
+#include "common/error.hpp"
+
+#include <Teuchos_ParameterList.hpp>
+#include <Teuchos_RCP.hpp>
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace cfdmpm {
+
+struct DomainSpec {
+  int dimension = 2;                          // 2 or 3
+  std::array<double, 3> lower{0, 0, 0};       // m; unused dimensions 0
+  std::array<double, 3> upper{1, 1, 1};       // m; unused dimensions 1
+  std::array<long long, 3> cells{1, 1, 1};    // cells per direction; unused dimensions 1
+  std::array<long long, 3> patch_cells{1, 1, 1};  // patch size in cells; unused dimensions 1
+  int ghost_width = 2;                        // ghost cell layers around each rank's cells
+  std::array<double, 3> gravity{0, 0, 0};     // m/s^2
+};
+
+struct MaterialSpec {
+  std::string name;
+  std::string kind;                 // "fluid" (ICE) or "solid" (MPM)
+  Teuchos::ParameterList parameters;  // the material's validated sublist
+};
+
+struct RegionSpec {
+  std::string name;
+  std::string material;
+  std::string shape;                         // "box", "polygon", "half_plane"
+  std::array<double, 3> lower{0, 0, 0};      // box
+  std::array<double, 3> upper{0, 0, 0};      // box
+  std::vector<std::array<double, 2>> vertices;  // polygon (2-D; extruded in z in 3-D)
+  std::array<double, 3> point{0, 0, 0};      // half_plane: a point on the plane
+  std::array<double, 3> normal{0, 0, 0};     // half_plane: outward normal (region is behind it)
+  std::array<double, 3> velocity{0, 0, 0};   // m/s
+  double temperature = 0;                    // K
+};
+
+struct BoundarySpec {
+  std::string face;        // "x-", "x+", "y-", "y+", "z-", "z+"
+  std::string velocity;    // "no_slip" or "free_slip"
+  std::string temperature; // "zero_gradient" or "fixed"
+  double temperature_value = 0;  // K, when temperature is "fixed"
+};
+
+struct TimeSpec {
+  double end_time = 0;    // s
+  double cfl = 0.25;
+  double dt_initial = 1e-5;  // s
+  double dt_min = 1e-10;     // s
+  double dt_max = 1e-2;      // s
+  long long max_steps = -1;  // -1: no limit
+};
+
+struct OutputSpec {
+  std::string directory;          // created; never silently overwritten
+  double interval = 0;            // s of simulated time between output steps; 0 = initial state only
+  std::vector<std::string> fields;
+  bool overwrite = false;
+  double progress_interval = 1.0;  // s of wall time between progress lines
+};
+
+struct InitialStateSpec {
+  std::string background_material;  // fills every cell that no region claims
+  double temperature = 293.15;      // K
+  double pressure = 101325;         // Pa, at the top of the domain
+  bool hydrostatic = true;          // integrate the pressure down from the top with the column's weight
+};
+
+struct Scene {
+  std::string path;
+  std::string title;
+  DomainSpec domain;
+  std::vector<MaterialSpec> materials;  // in file order; a material's index is its position here
+  InitialStateSpec initial;
+  std::vector<RegionSpec> regions;      // in file order; later regions overwrite earlier ones
+  std::vector<BoundarySpec> boundaries; // one per face of the domain (4 in 2-D, 6 in 3-D)
+  TimeSpec time;
+  OutputSpec output;
+  Teuchos::RCP<Teuchos::ParameterList> parameters;  // the whole validated list, defaults filled in
+
+  int materialIndex(const std::string& name) const;  // throws InputError if unknown
+};
+
+/// The list of valid parameters with defaults and documentation; the single source of truth for
+/// validation and for doc/input.md.
+Teuchos::RCP<const Teuchos::ParameterList> validSceneParameters();
+
+/// Reads and validates a scene file. Throws InputError (message: key, value, what is allowed) on
+/// any problem; nothing is written before it returns.
+Scene readScene(const std::string& path);
+
+}  // namespace cfdmpm

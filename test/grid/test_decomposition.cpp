@@ -1,0 +1,84 @@
+// METIS partition of the patch graph: balance for uniform work, and a shift toward weights.
+#include "grid/decomposition.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <numeric>
+
+using namespace cfdmpm;
+
+namespace {
+
+std::vector<double> cellWeights(const Grid<2>& grid)
+{
+  std::vector<double> w(grid.patchCount());
+  for (int p = 0; p < grid.patchCount(); ++p) w[p] = double(grid.patchCells(p).count());
+  return w;
+}
+
+double imbalance(const std::vector<double>& load)
+{
+  const double mean = std::accumulate(load.begin(), load.end(), 0.0) / double(load.size());
+  return *std::max_element(load.begin(), load.end()) / mean - 1.0;
+}
+
+}  // namespace
+
+TEST(Decomposition, UniformGridIsBalancedWithinTenPercent)
+{
+  // 700 x 400 cells in 16 x 16 patches (44 x 25 = 1100 patches, edge patches smaller).
+  const Grid<2> grid({0, 0, 0}, {3.5, 2.0, 0}, {700, 400, 1}, {16, 16, 1});
+  for (int ranks : {2, 3, 4, 7, 16}) {
+    const Decomposition dec = partitionPatches(grid, ranks);
+    const auto load = rankLoads(dec, cellWeights(grid));
+    // The bound: the heaviest rank within 10 % of the mean.
+    EXPECT_LT(imbalance(load), 0.10) << ranks << " ranks";
+    EXPECT_EQ(std::accumulate(load.begin(), load.end(), 0.0), double(grid.cellCount()));
+  }
+}
+
+TEST(Decomposition, ThreeDimensionalGridIsBalanced)
+{
+  const Grid<3> grid({0, 0, 0}, {1, 1, 1}, {64, 48, 40}, {8, 8, 8});
+  const Decomposition dec = partitionPatches(grid, 3);
+  std::vector<double> w(grid.patchCount());
+  for (int p = 0; p < grid.patchCount(); ++p) w[p] = double(grid.patchCells(p).count());
+  EXPECT_LT(imbalance(rankLoads(dec, w)), 0.10);
+}
+
+TEST(Decomposition, HeavyPatchesShiftTheCut)
+{
+  // Patches in the left quarter carry 4x the work (particles there, say). The rank that gets them
+  // must get fewer patches, and the weighted loads must again be balanced within 10 %.
+  const Grid<2> grid({0, 0, 0}, {1, 1, 0}, {256, 128, 1}, {16, 16, 1});
+  std::vector<double> w(grid.patchCount());
+  for (int p = 0; p < grid.patchCount(); ++p)
+    w[p] = (grid.patchIndex(p)[0] < 4 ? 4.0 : 1.0) * double(grid.patchCells(p).count());
+  const Decomposition weighted = partitionPatches(grid, 2, w);
+  const Decomposition uniform = partitionPatches(grid, 2);
+  EXPECT_LT(imbalance(rankLoads(weighted, w)), 0.10);
+  // Unweighted, the heavy work is lopsided (all of it on one side of a half-half cut).
+  EXPECT_GT(imbalance(rankLoads(uniform, w)), 0.20);
+  const int heavy_owner = weighted.patch_owner[0];
+  const auto heavy_patches = weighted.patchesOf(heavy_owner).size();
+  const auto light_patches = weighted.patchesOf(1 - heavy_owner).size();
+  EXPECT_LT(heavy_patches, light_patches);
+}
+
+TEST(Decomposition, SameAnswerEveryCall)
+{
+  const Grid<2> grid({0, 0, 0}, {1, 1, 0}, {100, 100, 1}, {10, 10, 1});
+  EXPECT_EQ(partitionPatches(grid, 3).patch_owner, partitionPatches(grid, 3).patch_owner);
+}
+
+TEST(Decomposition, TooFewPatchesNamesTheKey)
+{
+  const Grid<2> grid({0, 0, 0}, {1, 1, 0}, {16, 16, 1}, {16, 16, 1});
+  try {
+    partitionPatches(grid, 2);
+    FAIL() << "one patch for two ranks must be refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("domain.patch_cells"), std::string::npos);
+  }
+}

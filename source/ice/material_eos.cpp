@@ -1,0 +1,42 @@
+#include "ice/material_eos.hpp"
+
+namespace cfdmpm {
+
+ice::Eos fluidEos(const MaterialSpec& material)
+{
+  const Teuchos::ParameterList& eos = material.parameters.sublist("equation_of_state");
+  const std::string type = eos.get<std::string>("type");
+  if (type == "ideal_gas")
+    return ice::Eos(ice::IdealGas::fromGasConstant(eos.get<double>("gas_constant"), eos.get<double>("gamma")));
+  if (type == "linear_water")
+    // The input's thermal_expansion is the drop of density per kelvin (positive for water above
+    // 4 degC); eq. 5's beta enters with the opposite sign, hence the minus.
+    return ice::Eos(ice::LinearWater::fromBulkModulus(eos.get<double>("bulk_modulus"), eos.get<double>("reference_pressure"),
+                                            eos.get<double>("reference_density"),
+                                            eos.get<double>("reference_temperature"),
+                                            -eos.get<double>("thermal_expansion")));
+  if (type == "tait") {
+    const double rho0 = eos.get<double>("reference_density");
+    return ice::Eos(ice::Tait(rho0, std::sqrt(eos.get<double>("bulk_modulus") / rho0), eos.get<double>("exponent"),
+                    eos.get<double>("reference_pressure")));
+  }
+  throw InputError("materials." + material.name + ".equation_of_state.type: got '" + type +
+                   "'; allowed: linear_water, ideal_gas, tait");
+}
+
+std::vector<DensityOfState> densityFunctions(const Scene& scene)
+{
+  std::vector<DensityOfState> result;
+  for (const MaterialSpec& material : scene.materials) {
+    if (material.kind == "fluid") {
+      const ice::Eos eos = fluidEos(material);
+      result.emplace_back([eos](double p, double T) { return eos.density(p, T); });
+    } else {
+      const double rho = material.parameters.get<double>("density");
+      result.emplace_back([rho](double, double) { return rho; });
+    }
+  }
+  return result;
+}
+
+}  // namespace cfdmpm

@@ -1,0 +1,82 @@
+#include "mpmice/state_output.hpp"
+
+#include <Teuchos_DefaultMpiComm.hpp>
+
+#include <algorithm>
+
+namespace cfdmpm {
+
+namespace {
+
+MPI_Comm rawComm(const Teuchos::RCP<const Teuchos::Comm<int>>& comm)
+{
+  const auto mpi = Teuchos::rcp_dynamic_cast<const Teuchos::MpiComm<int>>(comm, true);
+  return *mpi->getRawMpiComm();
+}
+
+template <int Dim>
+OutputLayout outputLayout(const Grid<Dim>& grid, Location location, const std::vector<Box>& boxes)
+{
+  OutputLayout out;
+  out.dimension = Dim;
+  out.global_count = location == Location::Cell ? grid.cells() : grid.nodes();
+  for (int d = 0; d < 3; ++d) {
+    out.origin[d] = d < Dim ? grid.lower()[d] : 0.0;
+    out.spacing[d] = d < Dim ? grid.spacing()[d] : 1.0;
+  }
+  out.owned_boxes = boxes;
+  return out;
+}
+
+}  // namespace
+
+template <int Dim>
+StateOutput<Dim>::StateOutput(const Scene& scene, const Layout<Dim>& layout, const std::string& run_name)
+    : fields_(scene.output.fields), directory_(scene.output.directory)
+{
+  for (const auto& m : scene.materials) material_names_.push_back(m.name);
+  const MPI_Comm comm = rawComm(layout.comm());
+  const OutputLayout cells = outputLayout(layout.grid(), Location::Cell, layout.ownedCellBoxes());
+  const OutputLayout nodes = outputLayout(layout.grid(), Location::Node, layout.ownedNodeBoxes());
+  hdf5_ = std::make_unique<Hdf5Writer>(comm, directory_, run_name, cells, nodes);
+  xdmf_ = std::make_unique<XdmfWriter>(comm, directory_, run_name, cells, nodes);
+}
+
+template <int Dim>
+void StateOutput<Dim>::writeColumns(const Field<Dim>& field, int first_column, int components, const std::string& name)
+{
+  // Owned rows are in ascending global id, the order the writer expects; components interleave.
+  const auto v = field.view();
+  const LocalOrdinal n = field.ownedCount();
+  buffer_.resize(std::size_t(n) * components);
+  for (LocalOrdinal l = 0; l < n; ++l)
+    for (int c = 0; c < components; ++c) buffer_[std::size_t(l) * components + c] = v(l, first_column + c);
+  if (components == 1)
+    hdf5_->writeScalar(OutputLocation::Cells, name, buffer_.data(), buffer_.size());
+  else
+    hdf5_->writeVector(OutputLocation::Cells, name, buffer_.data(), buffer_.size());
+}
+
+template <int Dim>
+std::string StateOutput<Dim>::write(long long step, double time, const CellState<Dim>& state)
+{
+  auto wanted = [&](const char* name) { return std::find(fields_.begin(), fields_.end(), name) != fields_.end(); };
+  hdf5_->beginStep(step, time);
+  if (wanted("pressure")) writeColumns(state.pressure, 0, 1, "pressure");
+  for (int m = 0; m < state.materials; ++m) {
+    const std::string prefix = material_names_[m] + "/";
+    if (wanted("volume_fraction")) writeColumns(state.volume_fraction, m, 1, prefix + "volume_fraction");
+    if (wanted("density")) writeColumns(state.density, m, 1, prefix + "density");
+    if (wanted("specific_volume")) writeColumns(state.specific_volume, m, 1, prefix + "specific_volume");
+    if (wanted("temperature")) writeColumns(state.temperature, m, 1, prefix + "temperature");
+    if (wanted("velocity")) writeColumns(state.velocity, CellState<Dim>::velocityColumn(m, 0), Dim, prefix + "velocity");
+  }
+  const WrittenStep written = hdf5_->endStep();
+  xdmf_->addStep(written);
+  return directory_ + "/" + written.file;
+}
+
+template class StateOutput<2>;
+template class StateOutput<3>;
+
+}  // namespace cfdmpm

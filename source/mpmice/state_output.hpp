@@ -1,0 +1,37 @@
+#pragma once
+// Writes the cell state (and later node and particle fields) at an output step: one HDF5 file,
+// its XDMF sidecar and the time-series XDMF. Bridges fields (Tpetra) and the io module (buffers).
+#include "input/scene.hpp"
+#include "io/hdf5_writer.hpp"
+#include "io/xdmf_writer.hpp"
+#include "mpmice/cell_state.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace cfdmpm {
+
+template <int Dim>
+class StateOutput {
+ public:
+  /// The output directory must have been prepared (prepareOutputDirectory).
+  StateOutput(const Scene& scene, const Layout<Dim>& layout, const std::string& run_name);
+
+  /// Writes the fields listed in output.fields; returns the HDF5 file's path.
+  std::string write(long long step, double time, const CellState<Dim>& state);
+
+  std::string seriesPath() const { return xdmf_->seriesPath(); }
+
+ private:
+  void writeColumns(const Field<Dim>& field, int first_column, int components, const std::string& name);
+
+  std::vector<std::string> material_names_;
+  std::vector<std::string> fields_;
+  std::string directory_;
+  std::unique_ptr<Hdf5Writer> hdf5_;
+  std::unique_ptr<XdmfWriter> xdmf_;
+  std::vector<double> buffer_;
+};
+
+}  // namespace cfdmpm

@@ -1,0 +1,288 @@
+#pragma once
+// Implicit momentum and heat exchange between the materials of one cell or one face
+// (MPMICE step 4 and step 8; seed paper eqs. 2-3, f_rs = K_rs theta_r theta_s (u_r - u_s) and
+// q_rs = H_rs theta_r theta_s (T_r - T_s); Kashiwa et al. 2000, "A cell-centered ICE method for
+// multiphase flow simulations", LA-UR; Uintah ScalarExch::addExch_Vel_Temp_CC and vel_FC_exchange).
+//
+// The scheme. Per unit mass of material m the exchange force is sum_n K_mn theta_n v_m (u_n - u_m)
+// (v_m = specific volume), taken implicitly over the step dt:
+//
+//   u'_m = u_m + sum_n beta_mn (u'_n - u'_m),   beta_mn = dt v_m theta_n K_mn   (Uintah's beta),
+//
+// i.e. A u' = u with A = I + diag(sum_n beta_mn) - beta. Multiplying row m by the bulk density
+// w_m = theta_m/v_m gives the symmetric form
+//
+//   S u' = W u,   S = W + Laplacian(G),   G_mn = dt theta_m theta_n K_mn,   W = diag(w),
+//
+// whose columns sum to w: sum_m w_m u'_m = sum_m w_m u_m, the momentum is conserved exactly.
+//
+// How it is solved, and why. K = 1e15 (velocity equilibrium, as in the seed scene) makes G/w as
+// large as 1e10 or more. Solving Uintah's form A du = b directly by Gaussian elimination gives
+// errors of order eps * beta in the common (mass-weighted) velocity: the momentum error then grows
+// with K. Here instead:
+//   1. The conserved weighted mean ubar = sum w u / sum w is taken out: u' = ubar + d with
+//      S d = W (u - ubar) (A 1 = 1, so any constant shifts through). d is the part of the velocity
+//      that exchange drives to zero; for large K it is O(|u - ubar|/beta) and its error stays
+//      O(eps |u - ubar|) whatever K is.
+//   2. S is a symmetric, diagonally dominant M-matrix. It is eliminated subtraction-free (the GTH
+//      variant of Gaussian elimination: Grassmann, Taksar & Heyman 1985; its accuracy for diagonally
+//      dominant M-matrices: Alfa, Xue & Ye 2002): the matrix is held as its off-diagonal couplings
+//      G >= 0 and row sums w >= 0, every pivot is computed as a sum of non-negative numbers, never as
+//      1 + beta - beta^2/(1 + beta). Pivots are accurate for any K, even when 1 + beta rounds to beta.
+//      Partial pivoting would pick the diagonal at every step of this matrix (each column's diagonal
+//      is at least the sum of its other entries), so there is no row exchange to do.
+//   3. d is projected to sum w d = 0, making conservation exact to round-off by construction.
+// A material without mass (w_m = 0) exerts no force; its velocity follows its row of A,
+// u'_m = (u_m + sum_n beta_mn u'_n)/(1 + sum_n beta_mn), a convex combination of the others.
+//
+// Heat is the same with H_mn, T, w_m = rho_m cv_m and beta_mn = dt v_m theta_n H_mn/cv_m: it conserves
+// sum_m mass_m cv_m T_m.
+#include "ice/eos.hpp"
+
+#include <cfloat>
+
+namespace cfdmpm::ice {
+
+/// Symmetric exchange coefficients between materials, zero on the diagonal: K_mn [kg/(m^3 s)] for
+/// momentum, H_mn [W/(m^3 K)] for heat.
+struct ExchangeCoefficients {
+  double value[kMaxMaterials][kMaxMaterials];
+
+  KOKKOS_INLINE_FUNCTION ExchangeCoefficients()
+  {
+    for (int m = 0; m < kMaxMaterials; ++m)
+      for (int n = 0; n < kMaxMaterials; ++n) value[m][n] = 0.0;
+  }
+  /// The same coefficient between every pair of materials.
+  KOKKOS_INLINE_FUNCTION static ExchangeCoefficients uniform(double coefficient)
+  {
+    ExchangeCoefficients k;
+    for (int m = 0; m < kMaxMaterials; ++m)
+      for (int n = 0; n < kMaxMaterials; ++n) k.value[m][n] = m == n ? 0.0 : coefficient;
+    return k;
+  }
+  /// From the upper triangle in material order (01, 02, ..., 0N-1, 12, ...), as Uintah's input
+  /// <exchange_coefficients> lists them; `upper` holds count(count-1)/2 values.
+  KOKKOS_INLINE_FUNCTION static ExchangeCoefficients fromUpperTriangle(int count, const double* upper)
+  {
+    ExchangeCoefficients k;
+    int i = 0;
+    for (int m = 0; m < count; ++m)
+      for (int n = m + 1; n < count; ++n) k.set(m, n, upper[i++]);
+    return k;
+  }
+  KOKKOS_INLINE_FUNCTION void set(int m, int n, double coefficient)
+  {
+    value[m][n] = coefficient;
+    value[n][m] = coefficient;
+  }
+  KOKKOS_INLINE_FUNCTION double operator()(int m, int n) const { return value[m][n]; }
+};
+
+enum class ExchangeStatus : int {
+  Ok = 0,
+  NonFinite,     // an input or a result was infinite or not a number; the values are not to be used
+  InvalidInput,  // count outside 0 ... kMaxMaterials; nothing was changed
+};
+
+namespace detail {
+
+/// The exchange system of one cell or face, in the symmetric form of the file comment.
+struct ExchangeSystem {
+  int count;
+  MaterialArray<double> weight;      // w_m >= 0, the conserved weight per unit volume
+  MaterialArray<double> rate_scale;  // beta_mn = rate_scale_m theta_n K_mn dt (for massless rows)
+  MaterialArray<double> volume_fraction;
+  double dt;
+};
+
+KOKKOS_INLINE_FUNCTION bool isFinite(double x) { return x - x == 0.0; }
+
+/// Applies the implicit exchange in place to `components` quantities q[m][c] (velocity components,
+/// a temperature, a specific volume). Returns Ok unless something is not finite.
+template <int MaxComponents>
+KOKKOS_INLINE_FUNCTION ExchangeStatus implicitExchange(const ExchangeSystem& system,
+                                                       const ExchangeCoefficients& K,
+                                                       double (&q)[kMaxMaterials][MaxComponents],
+                                                       int components)
+{
+  const int count = system.count;  // 0 ... kMaxMaterials, checked by the callers
+
+  // Materials with mass take part in the solve; list them and their couplings G = dt theta theta K.
+  int present[kMaxMaterials];
+  int np = 0;
+  double total_weight = 0.0;
+  bool coupled = false;
+  for (int m = 0; m < count; ++m) {
+    if (!isFinite(system.weight[m]) || !isFinite(system.volume_fraction[m]) ||
+        !isFinite(system.rate_scale[m]))
+      return ExchangeStatus::NonFinite;
+    for (int c = 0; c < components; ++c)
+      if (!isFinite(q[m][c])) return ExchangeStatus::NonFinite;
+    if (system.weight[m] > 0.0) {
+      present[np++] = m;
+      total_weight += system.weight[m];
+    }
+    for (int n = 0; n < count; ++n)
+      if (n != m && K(m, n) != 0.0) coupled = true;
+  }
+  if (!coupled) return ExchangeStatus::Ok;  // no exchange: leave the values bit for bit
+
+  double g[kMaxMaterials][kMaxMaterials];  // couplings among present materials (row i, column j)
+  double excess[kMaxMaterials];            // row sums of S over the not yet eliminated columns
+  double pivot[kMaxMaterials];
+  double rhs[kMaxMaterials][MaxComponents];
+  double mean[MaxComponents];
+
+  // 1. The conserved weighted mean, and the right-hand side W (q - mean).
+  for (int c = 0; c < components; ++c) {
+    double sum = 0.0;
+    for (int i = 0; i < np; ++i) sum += system.weight[present[i]] * q[present[i]][c];
+    mean[c] = np > 0 ? sum / total_weight : 0.0;
+  }
+  for (int i = 0; i < np; ++i) {
+    const int m = present[i];
+    excess[i] = system.weight[m];
+    for (int j = 0; j < np; ++j)
+      g[i][j] = i == j ? 0.0 : system.dt * system.volume_fraction[m] * system.volume_fraction[present[j]] *
+                                   K(m, present[j]);
+    for (int c = 0; c < components; ++c) rhs[i][c] = system.weight[m] * (q[m][c] - mean[c]);
+  }
+
+  // 2. Subtraction-free elimination (GTH): pivot = row sum + couplings, all terms >= 0.
+  for (int k = 0; k < np; ++k) {
+    double p = excess[k];
+    for (int j = k + 1; j < np; ++j) p += g[k][j];
+    pivot[k] = p;
+    for (int i = k + 1; i < np; ++i) {
+      if (g[i][k] == 0.0) continue;
+      const double l = g[i][k] / p;  // 0 < l <= 1
+      excess[i] += l * excess[k];
+      for (int j = k + 1; j < np; ++j)
+        if (j != i) g[i][j] += l * g[k][j];
+      for (int c = 0; c < components; ++c) rhs[i][c] += l * rhs[k][c];
+    }
+  }
+  for (int k = np - 1; k >= 0; --k)
+    for (int c = 0; c < components; ++c) {
+      double x = rhs[k][c];
+      for (int j = k + 1; j < np; ++j) x += g[k][j] * rhs[j][c];
+      rhs[k][c] = x / pivot[k];
+    }
+
+  // 3. Project to sum w d = 0 and add the mean back.
+  for (int c = 0; c < components; ++c) {
+    double drift = 0.0;
+    for (int i = 0; i < np; ++i) drift += system.weight[present[i]] * rhs[i][c];
+    drift /= total_weight;
+    for (int i = 0; i < np; ++i) q[present[i]][c] = mean[c] + (rhs[i][c] - drift);
+  }
+
+  // Massless materials follow their row of A with the new values of the present ones.
+  for (int m = 0; m < count; ++m) {
+    if (system.weight[m] > 0.0) continue;
+    double beta_sum = 0.0;
+    double pull[MaxComponents];
+    for (int c = 0; c < components; ++c) pull[c] = 0.0;
+    for (int i = 0; i < np; ++i) {
+      const int n = present[i];
+      const double beta = system.dt * system.rate_scale[m] * system.volume_fraction[n] * K(m, n);
+      beta_sum += beta;
+      for (int c = 0; c < components; ++c) pull[c] += beta * q[n][c];
+    }
+    for (int c = 0; c < components; ++c) q[m][c] = (q[m][c] + pull[c]) / (1.0 + beta_sum);
+  }
+
+  for (int m = 0; m < count; ++m)
+    for (int c = 0; c < components; ++c)
+      if (!isFinite(q[m][c])) return ExchangeStatus::NonFinite;
+  return ExchangeStatus::Ok;
+}
+
+}  // namespace detail
+
+/// Cell-centred momentum exchange (Uintah addExch_Vel_Temp_CC, momentum part), in place.
+///   mass_density[m] = Lagrangian mass_m/V_cell [kg/m^3] (the weight of the conserved momentum);
+///   volume_fraction[m], specific_volume[m] [m^3/kg] from the equilibration; K [kg/(m^3 s)];
+///   velocity[m] [m/s], Dim components, replaced by the exchanged velocity.
+/// The symmetric form uses w_m = mass_density[m]; it equals Uintah's beta when
+/// mass_density = volume_fraction/specific_volume, as after the equilibration.
+template <int Dim>
+KOKKOS_INLINE_FUNCTION ExchangeStatus exchangeMomentumCC(int count, double dt, const ExchangeCoefficients& K,
+                                                         const MaterialArray<double>& mass_density,
+                                                         const MaterialArray<double>& volume_fraction,
+                                                         const MaterialArray<double>& specific_volume,
+                                                         MaterialArray<Kokkos::Array<double, Dim>>& velocity)
+{
+  if (count < 0 || count > kMaxMaterials) return ExchangeStatus::InvalidInput;
+  detail::ExchangeSystem system{count, mass_density, specific_volume, volume_fraction, dt};
+  double q[kMaxMaterials][Dim];
+  for (int m = 0; m < count; ++m)
+    for (int d = 0; d < Dim; ++d) q[m][d] = velocity[m][d];
+  const ExchangeStatus status = detail::implicitExchange<Dim>(system, K, q, Dim);
+  for (int m = 0; m < count; ++m)
+    for (int d = 0; d < Dim; ++d) velocity[m][d] = q[m][d];
+  return status;
+}
+
+/// Cell-centred heat exchange (Uintah addExch_Vel_Temp_CC, heat part), in place: conserves
+/// sum_m mass_m cv_m T_m. H [W/(m^3 K)], specific_heat[m] = cv_m [J/(kg K)], temperature [K].
+KOKKOS_INLINE_FUNCTION ExchangeStatus exchangeHeatCC(int count, double dt, const ExchangeCoefficients& H,
+                                                     const MaterialArray<double>& mass_density,
+                                                     const MaterialArray<double>& volume_fraction,
+                                                     const MaterialArray<double>& specific_volume,
+                                                     const MaterialArray<double>& specific_heat,
+                                                     MaterialArray<double>& temperature)
+{
+  if (count < 0 || count > kMaxMaterials) return ExchangeStatus::InvalidInput;
+  detail::ExchangeSystem system{count, {}, {}, volume_fraction, dt};
+  double q[kMaxMaterials][1];
+  for (int m = 0; m < count; ++m) {
+    system.weight[m] = mass_density[m] * specific_heat[m];
+    system.rate_scale[m] = specific_volume[m] / specific_heat[m];
+    q[m][0] = temperature[m];
+  }
+  const ExchangeStatus status = detail::implicitExchange<1>(system, H, q, 1);
+  for (int m = 0; m < count; ++m) temperature[m] = q[m][0];
+  return status;
+}
+
+/// Face momentum exchange (Uintah vel_FC_exchange; Kashiwa 2000 above eq. 4.13), in place, for the
+/// face-normal velocity of every material on one face between a left (L) and a right (R) cell.
+/// On the face, v_m = 2 v_L v_R/(v_L + v_R) (harmonic mean) and theta_m = (theta_L + theta_R)/2, so
+/// beta_mn = dt v_m theta_n K_mn and the conserved weight is theta_m/v_m.
+/// face_specific_volume receives A^-1 v: the specific volume with which the pressure gradient acts
+/// on each material's face velocity after the exchange (the pressure equation's coefficient). One
+/// material, or K = 0, gives the harmonic mean itself; K -> infinity gives sum theta/sum(theta/v),
+/// the mixture's specific volume, for every material.
+KOKKOS_INLINE_FUNCTION ExchangeStatus exchangeMomentumFC(int count, double dt, const ExchangeCoefficients& K,
+                                                         const MaterialArray<double>& volume_fraction_left,
+                                                         const MaterialArray<double>& volume_fraction_right,
+                                                         const MaterialArray<double>& specific_volume_left,
+                                                         const MaterialArray<double>& specific_volume_right,
+                                                         MaterialArray<double>& face_velocity,
+                                                         MaterialArray<double>& face_specific_volume)
+{
+  if (count < 0 || count > kMaxMaterials) return ExchangeStatus::InvalidInput;
+  detail::ExchangeSystem system{count, {}, {}, {}, dt};
+  double q[kMaxMaterials][2];
+  for (int m = 0; m < count; ++m) {
+    const double vl = specific_volume_left[m];
+    const double vr = specific_volume_right[m];
+    const double v = 2.0 * vl * vr / (vl + vr);
+    const double theta = 0.5 * (volume_fraction_left[m] + volume_fraction_right[m]);
+    system.volume_fraction[m] = theta;
+    system.rate_scale[m] = v;
+    system.weight[m] = theta / v;
+    q[m][0] = face_velocity[m];
+    q[m][1] = v;
+  }
+  const ExchangeStatus status = detail::implicitExchange<2>(system, K, q, 2);
+  for (int m = 0; m < count; ++m) {
+    face_velocity[m] = q[m][0];
+    face_specific_volume[m] = q[m][1];
+  }
+  return status;
+}
+
+}  // namespace cfdmpm::ice

@@ -1,0 +1,168 @@
+#include "io/xdmf_writer.hpp"
+
+#include "io/collective.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+namespace cfdmpm {
+namespace {
+
+std::string number(double value)
+{
+  char text[32];
+  std::snprintf(text, sizeof text, "%.17g", value);
+  return text;
+}
+
+std::string escaped(const std::string& text)
+{
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+/// "a b c" from the dims, slowest first.
+std::string dimensionList(const std::vector<long long>& dims)
+{
+  std::string out;
+  for (std::size_t i = 0; i < dims.size(); ++i) out += (i ? " " : "") + std::to_string(dims[i]);
+  return out;
+}
+
+/// Grid nodes per direction, slowest first: cells + 1; a 2-D grid is one node thick in z.
+std::vector<long long> nodeDims(const OutputLayout& cells)
+{
+  std::vector<long long> dims;
+  if (cells.dimension == 2) dims.push_back(1);
+  for (int d = cells.dimension - 1; d >= 0; --d) dims.push_back(cells.global_count[d] + 1);
+  return dims;
+}
+
+std::string attribute(const std::string& file, const WrittenField& field, const std::string& pad)
+{
+  const bool vector = field.components > 1;
+  return pad + "<Attribute Name=\"" + escaped(field.name) + "\" AttributeType=\"" +
+         (vector ? "Vector" : "Scalar") + "\" Center=\"" +
+         (field.location == OutputLocation::Cells ? "Cell" : "Node") + "\">\n" + pad +
+         "  <DataItem Dimensions=\"" + dimensionList(field.display_dims) +
+         "\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" + escaped(file) + ":" +
+         escaped(field.display_dataset) + "</DataItem>\n" + pad + "</Attribute>\n";
+}
+
+std::string documentHead() { return "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"2.0\">\n  <Domain>\n"; }
+std::string documentTail() { return "  </Domain>\n</Xdmf>\n"; }
+
+std::string stem(const std::string& file_name)
+{
+  return std::filesystem::path(file_name).stem().string();
+}
+
+bool nearlyEqual(double a, double b)
+{
+  return std::abs(a - b) <= 1e-12 * std::max({1.0, std::abs(a), std::abs(b)});
+}
+
+}  // namespace
+
+std::string xdmfGrid(const OutputLayout& cells, const WrittenStep& step, int indent)
+{
+  const std::string pad(static_cast<std::size_t>(indent), ' ');
+  // A 2-D grid is written as a 3-D grid one node thick at z = 0: ParaView's readers put a
+  // 2DCoRectMesh in the plane x = 0 (its x along ParaView's y), which would not match the
+  // (x, y, 0) vectors; this way both lie in the x-y plane.
+  std::string origin = cells.dimension == 2 ? "0 " : "";
+  std::string spacing =
+      cells.dimension == 2 ? number(std::min(cells.spacing[0], cells.spacing[1])) + " " : "";
+  for (int d = cells.dimension - 1; d >= 0; --d) {
+    origin += number(cells.origin[d]) + (d ? " " : "");
+    spacing += number(cells.spacing[d]) + (d ? " " : "");
+  }
+
+  std::string out = pad + "<Grid Name=\"" + escaped(stem(step.file)) + "\" GridType=\"Uniform\">\n";
+  out += pad + "  <Time Value=\"" + number(step.time) + "\"/>\n";
+  out += pad + "  <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"" +
+         dimensionList(nodeDims(cells)) + "\"/>\n";
+  out += pad + "  <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n";
+  out += pad + "    <DataItem Name=\"Origin\" Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" "
+               "Format=\"XML\">" + origin + "</DataItem>\n";
+  out += pad + "    <DataItem Name=\"Spacing\" Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" "
+               "Format=\"XML\">" + spacing + "</DataItem>\n";
+  out += pad + "  </Geometry>\n";
+  for (const WrittenField& field : step.fields) out += attribute(step.file, field, pad + "  ");
+  return out + pad + "</Grid>\n";
+}
+
+void writeFileAtomically(const std::string& path, const std::string& text)
+{
+  const std::string temporary = path + ".tmp";
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    out << text;
+    out.close();
+    if (!out) throw std::runtime_error("writing " + temporary + " failed");
+  }
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error) throw std::runtime_error("renaming " + temporary + " to " + path + ": " + error.message());
+}
+
+XdmfWriter::XdmfWriter(MPI_Comm comm, std::string directory, std::string run_name,
+                       const OutputLayout& cells, const OutputLayout& nodes)
+    : comm_(comm), directory_(std::move(directory)), run_name_(std::move(run_name)), cells_(cells)
+{
+  bool same_grid = cells.dimension == nodes.dimension;
+  for (int d = 0; d < cells.dimension && same_grid; ++d)
+    same_grid = nodes.global_count[d] == cells.global_count[d] + 1 &&
+                nearlyEqual(nodes.origin[d], cells.origin[d]) &&
+                nearlyEqual(nodes.spacing[d], cells.spacing[d]);
+  if (!same_grid)
+    throw std::invalid_argument("XdmfWriter: the node layout must have one more node than cells in "
+                                "each direction and the same origin and spacing");
+}
+
+std::string XdmfWriter::seriesPath() const
+{
+  return (std::filesystem::path(directory_) / (run_name_ + ".xmf")).string();
+}
+
+std::string XdmfWriter::stepPath(const WrittenStep& step) const
+{
+  return (std::filesystem::path(directory_) / (stem(step.file) + ".xmf")).string();
+}
+
+void XdmfWriter::addStep(const WrittenStep& step)
+{
+  bool replaced = false;
+  for (WrittenStep& earlier : steps_)
+    if (earlier.file == step.file) {
+      earlier = step;
+      replaced = true;
+    }
+  if (!replaced) steps_.push_back(step);
+
+  io_detail::onRankZero(comm_, [&] {
+    writeFileAtomically(stepPath(step), documentHead() + xdmfGrid(cells_, step, 4) + documentTail());
+
+    std::string series = documentHead();
+    series += "    <Grid Name=\"" + escaped(run_name_) +
+              "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+    for (const WrittenStep& written : steps_) series += xdmfGrid(cells_, written, 6);
+    series += "    </Grid>\n" + documentTail();
+    writeFileAtomically(seriesPath(), series);
+  });
+}
+
+}  // namespace cfdmpm

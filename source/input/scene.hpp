@@ -18,7 +18,7 @@ struct DomainSpec {
   std::array<double, 3> lower{0, 0, 0};       // m; unused dimensions 0
   std::array<double, 3> upper{1, 1, 1};       // m; unused dimensions 1
   std::array<long long, 3> cells{1, 1, 1};    // cells per direction; unused dimensions 1
-  std::array<long long, 3> patch_cells{1, 1, 1};  // patch size in cells; unused dimensions 1
+  std::array<long long, 3> patch_cells{1, 1, 1};  // patch size in cells, at most `cells`; unused dimensions 1
   int ghost_width = 2;                        // ghost cell layers around each rank's cells
   std::array<double, 3> gravity{0, 0, 0};     // m/s^2
 };
@@ -37,7 +37,7 @@ struct RegionSpec {
   std::array<double, 3> upper{0, 0, 0};      // box
   std::vector<std::array<double, 2>> vertices;  // polygon (2-D; extruded in z in 3-D)
   std::array<double, 3> point{0, 0, 0};      // half_plane: a point on the plane
-  std::array<double, 3> normal{0, 0, 0};     // half_plane: outward normal (region is behind it)
+  std::array<double, 3> normal{0, 0, 0};     // half_plane: outward unit normal (region is behind it)
   std::array<double, 3> velocity{0, 0, 0};   // m/s
   double temperature = 0;                    // K
 };
@@ -89,8 +89,27 @@ struct Scene {
 };
 
 /// The list of valid parameters with defaults and documentation; the single source of truth for
-/// validation and for doc/input.md.
+/// validation and for doc/input.md. Each entry carries a ParameterRule (input/parameter_rule.hpp).
+/// The named-entry sections (materials, regions, boundary_conditions) and the solver sections (ice,
+/// mpm) are empty here: their entries follow the templates below.
 Teuchos::RCP<const Teuchos::ParameterList> validSceneParameters();
+
+/// Templates for named entries, one per value of their selector key (which each template holds):
+/// a material of a `kind`, its `equation_of_state` or solid `model` of a `type`, a region of a
+/// `shape`, one face of `boundary_conditions`. Throw std::invalid_argument for an unknown name.
+Teuchos::RCP<const Teuchos::ParameterList> validMaterialParameters(const std::string& kind);
+Teuchos::RCP<const Teuchos::ParameterList> validEquationOfStateParameters(const std::string& type);
+Teuchos::RCP<const Teuchos::ParameterList> validSolidModelParameters(const std::string& type);
+Teuchos::RCP<const Teuchos::ParameterList> validRegionParameters(const std::string& shape);
+Teuchos::RCP<const Teuchos::ParameterList> validBoundaryParameters();
+
+/// The names the selector keys allow, in documentation order.
+const std::vector<std::string>& materialKinds();         // fluid, solid
+const std::vector<std::string>& equationOfStateTypes();  // linear_water, ideal_gas, tait
+const std::vector<std::string>& solidModelTypes();       // linear_elastic, neo_hookean, tresca, ...
+const std::vector<std::string>& regionShapes();          // box, polygon, half_plane
+const std::vector<std::string>& outputFieldNames();      // cell fields, then particle fields
+std::vector<std::string> boundaryFaces(int dimension);   // x-, x+, y-, y+ (, z-, z+)
 
 /// Reads and validates a scene file. Throws InputError (message: key, value, what is allowed) on
 /// any problem; nothing is written before it returns.

@@ -1,0 +1,421 @@
+// The valid-parameter lists of a scene: every key with its type, default, rule and meaning.
+// readScene validates against them and doc/input.md is generated from them (writeSceneReference).
+#include "input/parameter_rule.hpp"
+#include "input/scene.hpp"
+
+#include <Teuchos_Array.hpp>
+#include <Teuchos_Tuple.hpp>
+#include <Teuchos_TwoDArray.hpp>
+
+#include <map>
+#include <stdexcept>
+
+namespace cfdmpm {
+
+namespace {
+
+using Teuchos::Array;
+using Teuchos::ParameterList;
+using Teuchos::RCP;
+
+// --- Building blocks for rules: read as "required(perDirection(atLeast(1)))". ---
+ParameterRule unit(std::string si_unit)
+{
+  ParameterRule rule;
+  rule.unit = std::move(si_unit);
+  return rule;
+}
+
+ParameterRule between(double min, bool min_open, double max, bool max_open, std::string si_unit = "")
+{
+  ParameterRule rule = unit(std::move(si_unit));
+  rule.min = min;
+  rule.min_open = min_open;
+  rule.max = max;
+  rule.max_open = max_open;
+  return rule;
+}
+
+ParameterRule greaterThan(double min, std::string si_unit = "")
+{
+  ParameterRule rule = unit(std::move(si_unit));
+  rule.min = min;
+  rule.min_open = true;
+  return rule;
+}
+
+ParameterRule positive(std::string si_unit = "") { return greaterThan(0, std::move(si_unit)); }
+
+ParameterRule atLeast(double min, std::string si_unit = "")
+{
+  ParameterRule rule = unit(std::move(si_unit));
+  rule.min = min;
+  return rule;
+}
+
+ParameterRule oneOf(const std::vector<std::string>& choices)
+{
+  ParameterRule rule;
+  rule.choices = choices;
+  return rule;
+}
+
+ParameterRule required(ParameterRule rule)
+{
+  rule.required = true;
+  return rule;
+}
+
+ParameterRule perDirection(ParameterRule rule)
+{
+  rule.per_direction = true;
+  return rule;
+}
+
+ParameterRule derivedDefault(ParameterRule rule, std::string text)
+{
+  rule.derived_default = std::move(text);
+  return rule;
+}
+
+template <class T>
+void define(ParameterList& list, const std::string& key, const T& value, const std::string& doc,
+            ParameterRule rule)
+{
+  list.set(key, value, doc, Teuchos::rcp(new ParameterRuleValidator(std::move(rule), typeid(T))));
+}
+
+// A sublist. Free-form sections are not recursed into by Teuchos: readScene checks their entries
+// against a template chosen by a selector key, or leaves them to the module that owns them.
+ParameterList& defineSection(ParameterList& list, const std::string& key, const std::string& doc,
+                             bool is_required, bool free_form)
+{
+  ParameterList& section = list.sublist(key, false, doc);
+  if (free_form) section.disableRecursiveValidation();
+  ParameterRule rule;
+  rule.required = is_required;
+  list.getEntryPtr(key)->setValidator(
+      Teuchos::rcp(new ParameterRuleValidator(rule, typeid(ParameterList))));
+  return section;
+}
+
+Array<double> zeros(int n) { return Array<double>(n, 0.0); }
+
+// --- The fixed sections. ---
+
+void defineDomain(ParameterList& domain)
+{
+  define(domain, "dimension", 2, "Number of space dimensions; every per-direction list has this many entries.",
+         required(between(2, false, 3, false)));
+  define(domain, "lower", zeros(2), "Lower corner of the domain (x, y[, z]).", required(perDirection(unit("m"))));
+  define(domain, "upper", zeros(2), "Upper corner of the domain; above `lower` in every direction.",
+         required(perDirection(unit("m"))));
+  define(domain, "cells", Array<int>(2, 1), "Number of cells per direction.", required(perDirection(atLeast(1))));
+  define(domain, "patch_cells", Array<int>(2, 16),
+         "Patch size in cells per direction; patches are the units of the domain decomposition. Values above "
+         "`cells` are clipped to it.",
+         derivedDefault(perDirection(atLeast(1)), "16 per direction, clipped to `cells`"));
+  define(domain, "ghost_width", 2, "Layers of ghost cells around each rank's cells.", atLeast(1));
+  define(domain, "gravity", zeros(2), "Gravitational acceleration, e.g. [0, -9.81] in 2-D with y up.",
+         required(perDirection(unit("m/s^2"))));
+}
+
+void defineInitialState(ParameterList& initial)
+{
+  define(initial, "background_material", std::string("air"),
+         "The fluid material that fills every cell no region claims.", required(ParameterRule{}));
+  define(initial, "temperature", 293.15, "Temperature of the background, and of regions that give none.",
+         positive("K"));
+  define(initial, "pressure", 101325.0, "Pressure at the top of the domain.", positive("Pa"));
+  define(initial, "hydrostatic", true,
+         "true: integrate the pressure down from the top with the weight of the column above; false: uniform "
+         "`pressure`.",
+         ParameterRule{});
+}
+
+void defineTime(ParameterList& time)
+{
+  define(time, "end_time", 1.0, "Simulated time at which the run stops.", required(positive("s")));
+  define(time, "cfl", 0.25, "Courant number that sets the time step.", between(0, true, 1, false));
+  define(time, "dt_initial", 1.0e-5, "First time step; between `dt_min` and `dt_max`.", positive("s"));
+  define(time, "dt_min", 1.0e-10, "Smallest time step; the run stops with an error if it needs a smaller one.",
+         atLeast(0, "s"));
+  define(time, "dt_max", 1.0e-2, "Largest time step.", positive("s"));
+  define(time, "max_steps", -1LL, "Stop after this many steps; -1: no limit.", atLeast(-1));
+}
+
+void defineOutput(ParameterList& output)
+{
+  define(output, "directory", std::string("output"),
+         "Directory the results are written to; an existing one is refused unless `overwrite` is true.",
+         required(ParameterRule{}));
+  define(output, "interval", 0.01, "Simulated time between output steps; 0: the initial state only.",
+         required(atLeast(0, "s")));
+  define(output, "fields",
+         Array<std::string>(Teuchos::tuple<std::string>("volume_fraction", "density", "velocity", "temperature", "pressure")),
+         "Fields written at each output step; cell fields per material, particle fields per particle.",
+         oneOf(outputFieldNames()));
+  define(output, "overwrite", false, "true: write into an existing `directory`, replacing its files.",
+         ParameterRule{});
+  define(output, "progress_interval", 1.0, "Wall-clock time between progress lines; 0: one line per step.",
+         atLeast(0, "s"));
+}
+
+RCP<ParameterList> buildSceneParameters()
+{
+  auto scene = Teuchos::rcp(new ParameterList("cfdmpm"));
+  define(*scene, "title", std::string(""), "A line describing the scene, copied into the output.",
+         ParameterRule{});
+  defineDomain(defineSection(*scene, "domain", "The box the grid covers and its cells.", true, false));
+  defineSection(*scene, "materials",
+                "Named materials; the order is the material index. Keys of each entry: see the templates for "
+                "`kind: fluid` and `kind: solid`.",
+                true, true);
+  defineInitialState(defineSection(*scene, "initial_state", "What fills the domain at t = 0.", true, false));
+  defineSection(*scene, "regions",
+                "Named regions that place materials; later regions overwrite earlier ones. Keys of each entry: "
+                "see the templates for each `shape`.",
+                false, true);
+  defineSection(*scene, "boundary_conditions",
+                "One entry per face of the domain (x-, x+, y-, y+, and z-, z+ in 3-D); faces not given are "
+                "no_slip / zero_gradient.",
+                false, true);
+  defineTime(defineSection(*scene, "time", "Time span and time-step control.", true, false));
+  defineOutput(defineSection(*scene, "output", "What is written, where and how often.", true, false));
+  defineSection(*scene, "ice", "Settings of the fluid (ICE) solver; checked by that solver.", false, true);
+  defineSection(*scene, "mpm", "Settings of the particle (MPM) solver; checked by that solver.", false, true);
+  return scene;
+}
+
+// --- The templates of named entries. ---
+
+RCP<ParameterList> buildMaterial(const std::string& kind)
+{
+  auto material = Teuchos::rcp(new ParameterList("material"));
+  define(*material, "kind", kind, "fluid: moved by the ICE solver; solid: carried by MPM particles.",
+         required(oneOf(materialKinds())));
+  if (kind == "fluid") {
+    defineSection(*material, "equation_of_state",
+                  "Relation of pressure, density and temperature; keys depend on its `type`.", true, true);
+    define(*material, "viscosity", 0.0, "Dynamic viscosity.", required(atLeast(0, "Pa s")));
+    define(*material, "specific_heat", 1.0, "Specific heat at constant volume.",
+           derivedDefault(positive("J/(kg K)"),
+                          "gas_constant / (gamma - 1) for `ideal_gas`; required for other equations of state"));
+    define(*material, "thermal_conductivity", 0.0, "Thermal conductivity.", atLeast(0, "W/(m K)"));
+  } else {
+    define(*material, "density", 1000.0, "Density of the solid at rest.", required(positive("kg/m^3")));
+    defineSection(*material, "model", "Constitutive model; keys depend on its `type`.", true, true);
+    define(*material, "particles_per_cell", 2, "Material points per cell in each direction.", atLeast(1));
+  }
+  return material;
+}
+
+RCP<ParameterList> buildEquationOfState(const std::string& type)
+{
+  auto eos = Teuchos::rcp(new ParameterList("equation_of_state"));
+  define(*eos, "type", type,
+         "linear_water: p - p0 = (K / rho0) ((rho - rho0) + beta (T - T0)) (seed paper eq. 5, beta the density "
+         "drop per kelvin); ideal_gas: p = rho R T; tait: p = p0 + (K / n) ((rho / rho0)^n - 1).",
+         required(oneOf(equationOfStateTypes())));
+  if (type == "linear_water") {
+    define(*eos, "bulk_modulus", 2.15e9, "Bulk modulus K.", required(positive("Pa")));
+    define(*eos, "reference_density", 999.8, "Density at the reference pressure and temperature.",
+           required(positive("kg/m^3")));
+    define(*eos, "reference_pressure", 101325.0, "Reference pressure.", positive("Pa"));
+    define(*eos, "reference_temperature", 293.15, "Reference temperature.", positive("K"));
+    define(*eos, "thermal_expansion", 0.0,
+           "beta: the drop of density per kelvin at constant pressure; positive for water above 4 C (seed paper: "
+           "0.18).",
+           unit("kg/(m^3 K)"));
+  } else if (type == "ideal_gas") {
+    define(*eos, "gas_constant", 287.0, "Specific gas constant R.", positive("J/(kg K)"));
+    define(*eos, "gamma", 1.4, "Ratio of specific heats.", greaterThan(1));
+  } else {
+    define(*eos, "reference_density", 999.8, "Density at the reference pressure.", required(positive("kg/m^3")));
+    define(*eos, "reference_pressure", 101325.0, "Reference pressure p0.", positive("Pa"));
+    define(*eos, "bulk_modulus", 2.15e9, "Bulk modulus K at the reference density.", required(positive("Pa")));
+    define(*eos, "exponent", 7.0, "Exponent n.", positive());
+  }
+  return eos;
+}
+
+RCP<ParameterList> buildSolidModel(const std::string& type)
+{
+  auto model = Teuchos::rcp(new ParameterList("model"));
+  define(*model, "type", type,
+         "linear_elastic (small strain); neo_hookean (hyperelastic); tresca (elastic-perfectly plastic, no plastic "
+         "volume change); drucker_prager (pressure-dependent plasticity); rigid (moves at a set velocity).",
+         required(oneOf(solidModelTypes())));
+  auto elasticity = [&]() {
+    define(*model, "youngs_modulus", 1.0e7, "Young's modulus E.", required(positive("Pa")));
+    define(*model, "poisson_ratio", 0.3, "Poisson's ratio.", required(between(-1, true, 0.5, true)));
+  };
+  if (type == "linear_elastic") {
+    elasticity();
+  } else if (type == "neo_hookean") {
+    define(*model, "bulk_modulus", 1.0e9, "Bulk modulus K.", required(positive("Pa")));
+    define(*model, "shear_modulus", 1.0e9, "Shear modulus G.", required(positive("Pa")));
+  } else if (type == "tresca") {
+    elasticity();
+    define(*model, "yield_stress", 200.0,
+           "Maximum shear stress at yield (undrained shear strength c; the seed paper's 200 Pa). A uniaxial "
+           "yield stress sigma_y corresponds to sigma_y / 2.",
+           required(positive("Pa")));
+  } else if (type == "drucker_prager") {
+    elasticity();
+    define(*model, "friction_angle", 30.0, "Internal friction angle.",
+           required(between(0, false, 90, true, "degree")));
+    define(*model, "cohesion", 0.0, "Cohesion c; above 0 when `friction_angle` is 0.", atLeast(0, "Pa"));
+    define(*model, "dilatancy_angle", 0.0, "Dilatancy angle; at most `friction_angle`.",
+           between(0, false, 90, true, "degree"));
+    define(*model, "fit", std::string("plane_strain"),
+           "How the cone is fitted to Mohr-Coulomb: plane_strain (exact in plane strain, for 2-D), outer_cone "
+           "(through triaxial compression), inner_cone (through triaxial extension).",
+           oneOf({"plane_strain", "outer_cone", "inner_cone"}));
+  } else {
+    define(*model, "velocity", zeros(2), "Velocity of the rigid body.",
+           derivedDefault(perDirection(unit("m/s")), "zero"));
+  }
+  return model;
+}
+
+RCP<ParameterList> buildRegion(const std::string& shape)
+{
+  auto region = Teuchos::rcp(new ParameterList("region"));
+  define(*region, "material", std::string("water"), "The material the region holds.", required(ParameterRule{}));
+  define(*region, "shape", shape,
+         "box: between two corners; polygon: inside a closed polygon in the x-y plane (extruded over z in 3-D); "
+         "half_plane: the side of a plane opposite to its normal.",
+         required(oneOf(regionShapes())));
+  if (shape == "box") {
+    define(*region, "lower", zeros(2), "Lower corner; inside the domain.", required(perDirection(unit("m"))));
+    define(*region, "upper", zeros(2), "Upper corner; inside the domain and above `lower`.",
+           required(perDirection(unit("m"))));
+  } else if (shape == "polygon") {
+    define(*region, "vertices", Teuchos::TwoDArray<double>(3, 2, 0.0),
+           "Corners [x, y] in order (either sense), at least 3, inside the domain; the polygon closes itself.",
+           required(unit("m")));
+  } else {
+    define(*region, "point", zeros(2), "A point on the plane.", required(perDirection(unit("m"))));
+    define(*region, "normal", zeros(2),
+           "Normal of the plane (any length, not zero); the region is the side it points away from.",
+           required(perDirection(ParameterRule{})));
+  }
+  define(*region, "velocity", zeros(2), "Initial velocity.", derivedDefault(perDirection(unit("m/s")), "zero"));
+  define(*region, "temperature", 293.15, "Initial temperature.",
+         derivedDefault(positive("K"), "`initial_state.temperature`"));
+  return region;
+}
+
+RCP<ParameterList> buildBoundary()
+{
+  auto face = Teuchos::rcp(new ParameterList("face"));
+  define(*face, "velocity", std::string("no_slip"),
+         "no_slip: every velocity component is zero on the face; free_slip: only the normal one.",
+         oneOf({"no_slip", "free_slip"}));
+  define(*face, "temperature", std::string("zero_gradient"),
+         "zero_gradient: no heat flux through the face; fixed: the face is held at `temperature_value`.",
+         oneOf({"zero_gradient", "fixed"}));
+  define(*face, "temperature_value", 293.15, "Face temperature when `temperature` is fixed.",
+         derivedDefault(positive("K"), "`initial_state.temperature`"));
+  return face;
+}
+
+// One template per name, built once.
+RCP<const ParameterList> lookUp(const std::map<std::string, RCP<const ParameterList>>& templates,
+                                const std::string& name, const std::string& what)
+{
+  auto found = templates.find(name);
+  if (found == templates.end()) throw std::invalid_argument("no " + what + " named '" + name + "'");
+  return found->second;
+}
+
+template <class Build>
+std::map<std::string, RCP<const ParameterList>> buildAll(const std::vector<std::string>& names, Build build)
+{
+  std::map<std::string, RCP<const ParameterList>> templates;
+  for (const auto& name : names) templates[name] = build(name);
+  return templates;
+}
+
+}  // namespace
+
+const std::vector<std::string>& materialKinds()
+{
+  static const std::vector<std::string> names{"fluid", "solid"};
+  return names;
+}
+
+const std::vector<std::string>& equationOfStateTypes()
+{
+  static const std::vector<std::string> names{"linear_water", "ideal_gas", "tait"};
+  return names;
+}
+
+const std::vector<std::string>& solidModelTypes()
+{
+  static const std::vector<std::string> names{"linear_elastic", "neo_hookean", "tresca", "drucker_prager", "rigid"};
+  return names;
+}
+
+const std::vector<std::string>& regionShapes()
+{
+  static const std::vector<std::string> names{"box", "polygon", "half_plane"};
+  return names;
+}
+
+const std::vector<std::string>& outputFieldNames()
+{
+  static const std::vector<std::string> names{
+      "volume_fraction", "density", "velocity", "temperature", "pressure", "specific_volume", "sound_speed",
+      "particle_velocity", "particle_stress", "plastic_strain", "particle_material"};
+  return names;
+}
+
+std::vector<std::string> boundaryFaces(int dimension)
+{
+  std::vector<std::string> faces{"x-", "x+", "y-", "y+"};
+  if (dimension == 3) {
+    faces.push_back("z-");
+    faces.push_back("z+");
+  }
+  return faces;
+}
+
+Teuchos::RCP<const Teuchos::ParameterList> validSceneParameters()
+{
+  static const RCP<const ParameterList> scene = buildSceneParameters();
+  return scene;
+}
+
+Teuchos::RCP<const Teuchos::ParameterList> validMaterialParameters(const std::string& kind)
+{
+  static const auto templates = buildAll(materialKinds(), buildMaterial);
+  return lookUp(templates, kind, "material kind");
+}
+
+Teuchos::RCP<const Teuchos::ParameterList> validEquationOfStateParameters(const std::string& type)
+{
+  static const auto templates = buildAll(equationOfStateTypes(), buildEquationOfState);
+  return lookUp(templates, type, "equation of state type");
+}
+
+Teuchos::RCP<const Teuchos::ParameterList> validSolidModelParameters(const std::string& type)
+{
+  static const auto templates = buildAll(solidModelTypes(), buildSolidModel);
+  return lookUp(templates, type, "solid model type");
+}
+
+Teuchos::RCP<const Teuchos::ParameterList> validRegionParameters(const std::string& shape)
+{
+  static const auto templates = buildAll(regionShapes(), buildRegion);
+  return lookUp(templates, shape, "region shape");
+}
+
+Teuchos::RCP<const Teuchos::ParameterList> validBoundaryParameters()
+{
+  static const RCP<const ParameterList> face = buildBoundary();
+  return face;
+}
+
+}  // namespace cfdmpm

@@ -1,0 +1,251 @@
+// A valid scene fills every field of Scene; keys left out take their defaults; integers are
+// accepted where numbers are expected.
+#include "scene_test_support.hpp"
+
+#include <Teuchos_Array.hpp>
+#include <Teuchos_Tuple.hpp>
+
+namespace cfdmpm::test {
+namespace {
+
+using Teuchos::Array;
+
+TEST_F(SceneTest, FullSceneFillsEveryField)
+{
+  const Scene scene = readScene(write(kFullScene));
+  EXPECT_EQ(scene.title, "Test tank");
+
+  const DomainSpec& domain = scene.domain;
+  EXPECT_EQ(domain.dimension, 2);
+  EXPECT_EQ(domain.lower, (std::array<double, 3>{0.0, -0.5, 0.0}));
+  EXPECT_EQ(domain.upper, (std::array<double, 3>{1.0, 0.5, 1.0}));
+  EXPECT_EQ(domain.cells, (std::array<long long, 3>{20, 10, 1}));
+  EXPECT_EQ(domain.patch_cells, (std::array<long long, 3>{10, 5, 1}));
+  EXPECT_EQ(domain.ghost_width, 3);
+  EXPECT_EQ(domain.gravity, (std::array<double, 3>{0.0, -9.81, 0.0}));
+
+  // Materials in file order, each with its validated sublist.
+  ASSERT_EQ(scene.materials.size(), 3u);
+  EXPECT_EQ(scene.materials[0].name, "water");
+  EXPECT_EQ(scene.materials[0].kind, "fluid");
+  EXPECT_EQ(scene.materials[1].name, "air");
+  EXPECT_EQ(scene.materials[2].name, "sand");
+  EXPECT_EQ(scene.materials[2].kind, "solid");
+  EXPECT_EQ(scene.materialIndex("sand"), 2);
+  EXPECT_THROW(scene.materialIndex("mud"), InputError);
+  const auto& water = scene.materials[0].parameters;
+  EXPECT_EQ(water.get<double>("viscosity"), 1.0e-3);
+  EXPECT_EQ(water.get<double>("specific_heat"), 4200.0);
+  EXPECT_EQ(water.get<double>("thermal_conductivity"), 0.6);
+  const auto& eos = water.sublist("equation_of_state");
+  EXPECT_EQ(eos.get<std::string>("type"), "linear_water");
+  EXPECT_EQ(eos.get<double>("bulk_modulus"), 2.15e9);
+  EXPECT_EQ(eos.get<double>("reference_density"), 999.8);
+  EXPECT_EQ(eos.get<double>("reference_pressure"), 101000.0);
+  EXPECT_EQ(eos.get<double>("reference_temperature"), 278.15);
+  EXPECT_EQ(eos.get<double>("thermal_expansion"), 0.18);
+  const auto& sand = scene.materials[2].parameters;
+  EXPECT_EQ(sand.get<double>("density"), 1985.0);
+  EXPECT_EQ(sand.get<int>("particles_per_cell"), 3);
+  EXPECT_EQ(sand.sublist("model").get<std::string>("type"), "tresca");
+  EXPECT_EQ(sand.sublist("model").get<double>("youngs_modulus"), 5.0e7);
+  EXPECT_EQ(sand.sublist("model").get<double>("poisson_ratio"), 0.25);
+  EXPECT_EQ(sand.sublist("model").get<double>("yield_stress"), 200.0);
+
+  EXPECT_EQ(scene.initial.background_material, "air");
+  EXPECT_EQ(scene.initial.temperature, 280.0);
+  EXPECT_EQ(scene.initial.pressure, 100000.0);
+  EXPECT_FALSE(scene.initial.hydrostatic);
+
+  ASSERT_EQ(scene.regions.size(), 3u);
+  const RegionSpec& pool = scene.regions[0];
+  EXPECT_EQ(pool.name, "pool");
+  EXPECT_EQ(pool.material, "water");
+  EXPECT_EQ(pool.shape, "half_plane");
+  EXPECT_EQ(pool.point, (std::array<double, 3>{0.0, 0.1, 0.0}));
+  EXPECT_EQ(pool.normal, (std::array<double, 3>{0.0, 1.0, 0.0}));  // made unit length
+  EXPECT_EQ(pool.velocity, (std::array<double, 3>{0.0, 0.0, 0.0}));
+  EXPECT_EQ(pool.temperature, 280.0);  // initial_state.temperature
+  const RegionSpec& block = scene.regions[1];
+  EXPECT_EQ(block.shape, "box");
+  EXPECT_EQ(block.lower, (std::array<double, 3>{0.2, -0.5, 0.0}));
+  EXPECT_EQ(block.upper, (std::array<double, 3>{0.4, -0.3, 0.0}));
+  EXPECT_EQ(block.velocity, (std::array<double, 3>{0.5, -0.25, 0.0}));
+  EXPECT_EQ(block.temperature, 285.0);
+  const RegionSpec& wedge = scene.regions[2];
+  EXPECT_EQ(wedge.shape, "polygon");
+  ASSERT_EQ(wedge.vertices.size(), 3u);
+  EXPECT_EQ(wedge.vertices[2], (std::array<double, 2>{0.9, -0.2}));
+
+  ASSERT_EQ(scene.boundaries.size(), 4u);
+  EXPECT_EQ(scene.boundaries[0].face, "x-");
+  EXPECT_EQ(scene.boundaries[0].velocity, "free_slip");
+  EXPECT_EQ(scene.boundaries[0].temperature, "fixed");
+  EXPECT_EQ(scene.boundaries[0].temperature_value, 290.0);
+  EXPECT_EQ(scene.boundaries[1].face, "x+");
+  EXPECT_EQ(scene.boundaries[1].velocity, "no_slip");
+  EXPECT_EQ(scene.boundaries[3].face, "y+");
+  EXPECT_EQ(scene.boundaries[3].velocity, "free_slip");
+  EXPECT_EQ(scene.boundaries[3].temperature, "zero_gradient");
+
+  EXPECT_EQ(scene.time.end_time, 0.5);
+  EXPECT_EQ(scene.time.cfl, 0.4);
+  EXPECT_EQ(scene.time.dt_initial, 1.0e-4);
+  EXPECT_EQ(scene.time.dt_min, 1.0e-8);
+  EXPECT_EQ(scene.time.dt_max, 1.0e-3);
+  EXPECT_EQ(scene.time.max_steps, 1000);
+
+  EXPECT_EQ(scene.output.directory, "out/test");
+  EXPECT_EQ(scene.output.interval, 0.1);
+  EXPECT_EQ(scene.output.fields, (std::vector<std::string>{"velocity", "pressure", "particle_stress"}));
+  EXPECT_TRUE(scene.output.overwrite);
+  EXPECT_EQ(scene.output.progress_interval, 5.0);
+
+  // The solver sections are passed on untouched.
+  ASSERT_FALSE(scene.parameters.is_null());
+  EXPECT_EQ(scene.parameters->sublist("ice").get<int>("note"), 1);
+  EXPECT_TRUE(scene.parameters->isSublist("mpm"));
+  EXPECT_EQ(scene.path, directory_.string() + "/scene.yaml");
+}
+
+TEST_F(SceneTest, MissingKeysTakeTheirDefaults)
+{
+  const Scene scene = readScene(write(kMinimalScene));
+  EXPECT_EQ(scene.title, "");
+  EXPECT_EQ(scene.domain.patch_cells, (std::array<long long, 3>{16, 10, 1}));  // 16, clipped to cells
+  EXPECT_EQ(scene.domain.ghost_width, 2);
+  EXPECT_EQ(scene.initial.temperature, 293.15);
+  EXPECT_EQ(scene.initial.pressure, 101325.0);
+  EXPECT_TRUE(scene.initial.hydrostatic);
+  EXPECT_TRUE(scene.regions.empty());
+
+  ASSERT_EQ(scene.boundaries.size(), 4u);
+  const std::vector<std::string> faces{"x-", "x+", "y-", "y+"};
+  for (size_t i = 0; i < faces.size(); ++i) {
+    EXPECT_EQ(scene.boundaries[i].face, faces[i]);
+    EXPECT_EQ(scene.boundaries[i].velocity, "no_slip");
+    EXPECT_EQ(scene.boundaries[i].temperature, "zero_gradient");
+    EXPECT_EQ(scene.boundaries[i].temperature_value, 293.15);
+  }
+
+  EXPECT_EQ(scene.time.cfl, 0.25);
+  EXPECT_EQ(scene.time.dt_initial, 1.0e-5);
+  EXPECT_EQ(scene.time.dt_min, 1.0e-10);
+  EXPECT_EQ(scene.time.dt_max, 1.0e-2);
+  EXPECT_EQ(scene.time.max_steps, -1);
+  EXPECT_EQ(scene.output.fields,
+            (std::vector<std::string>{"volume_fraction", "density", "velocity", "temperature", "pressure"}));
+  EXPECT_FALSE(scene.output.overwrite);
+  EXPECT_EQ(scene.output.progress_interval, 1.0);
+
+  // Defaults are in the parameter list too, where the solvers read them.
+  const auto& air = scene.materials.at(0).parameters;
+  EXPECT_EQ(air.sublist("equation_of_state").get<double>("gas_constant"), 287.0);
+  EXPECT_EQ(air.sublist("equation_of_state").get<double>("gamma"), 1.4);
+  EXPECT_DOUBLE_EQ(air.get<double>("specific_heat"), 287.0 / 0.4);  // c_v = R / (gamma - 1)
+  EXPECT_EQ(air.get<double>("thermal_conductivity"), 0.0);
+  EXPECT_TRUE(scene.parameters->isSublist("ice"));
+  EXPECT_TRUE(scene.parameters->isSublist("mpm"));
+  EXPECT_EQ(scene.parameters->sublist("domain").get<int>("ghost_width"), 2);
+}
+
+TEST_F(SceneTest, IntegersAreAcceptedWhereNumbersAreExpected)
+{
+  const Scene scene = readScene(write(kMinimalScene));
+  EXPECT_EQ(scene.domain.lower, (std::array<double, 3>{0.0, 0.0, 0.0}));
+  EXPECT_EQ(scene.domain.upper, (std::array<double, 3>{1.0, 2.0, 1.0}));
+  EXPECT_EQ(scene.domain.gravity, (std::array<double, 3>{0.0, -10.0, 0.0}));
+  EXPECT_EQ(scene.time.end_time, 1.0);
+  const auto& domain = scene.parameters->sublist("domain");
+  EXPECT_TRUE(domain.isType<Array<double>>("upper"));  // converted in the list as well
+  EXPECT_TRUE(scene.materials.at(0).parameters.isType<double>("viscosity"));
+
+  const Scene with_polygon = readScene(write(replaced(kFullScene, "vertices: [[0.6, -0.5], [0.9, -0.5], [0.9, -0.2]]",
+                                                      "vertices: [[0, 0], [1, 0], [1, 0.5]]")));
+  EXPECT_EQ(with_polygon.regions[2].vertices[1], (std::array<double, 2>{1.0, 0.0}));
+}
+
+TEST_F(SceneTest, ThreeDimensionalSceneHasSixFacesAndThreeComponents)
+{
+  const std::string scene_text = R"(cfdmpm:
+  domain:
+    dimension: 3
+    lower: [0, 0, 0]
+    upper: [1, 1, 2]
+    cells: [10, 20, 40]
+    gravity: [0, 0, -9.81]
+  materials:
+    air: {kind: fluid, equation_of_state: {type: ideal_gas}, viscosity: 1.8e-5}
+    rock: {kind: solid, density: 2600, model: {type: rigid}}
+  initial_state: {background_material: air}
+  regions:
+    ledge: {material: rock, shape: polygon, vertices: [[0, 0], [1, 0], [0, 1]]}
+    cube: {material: rock, shape: box, lower: [0.1, 0.1, 0.1], upper: [0.2, 0.2, 1.9], velocity: [0, 0, -1]}
+  boundary_conditions:
+    z+: {velocity: free_slip}
+  time: {end_time: 1}
+  output: {directory: out, interval: 0.5}
+)";
+  const Scene scene = readScene(write(scene_text));
+  EXPECT_EQ(scene.domain.dimension, 3);
+  EXPECT_EQ(scene.domain.cells, (std::array<long long, 3>{10, 20, 40}));
+  EXPECT_EQ(scene.domain.patch_cells, (std::array<long long, 3>{10, 16, 16}));
+  EXPECT_EQ(scene.domain.upper, (std::array<double, 3>{1.0, 1.0, 2.0}));
+  ASSERT_EQ(scene.boundaries.size(), 6u);
+  EXPECT_EQ(scene.boundaries[5].face, "z+");
+  EXPECT_EQ(scene.boundaries[5].velocity, "free_slip");
+  EXPECT_EQ(scene.regions[1].velocity, (std::array<double, 3>{0.0, 0.0, -1.0}));
+  EXPECT_EQ(scene.regions[1].upper, (std::array<double, 3>{0.2, 0.2, 1.9}));
+  // A rigid body without a velocity is at rest, with one entry per direction.
+  EXPECT_EQ(scene.materials[1].parameters.sublist("model").get<Array<double>>("velocity"), Array<double>(3, 0.0));
+}
+
+TEST_F(SceneTest, RegionOnTheDomainBoundaryWithinRoundOffIsAccepted)
+{
+  // 1e-13 beyond a 1 m domain is round-off (the tolerance is 1e-12 of the domain size).
+  const Scene scene = readScene(write(replaced(kFullScene, "upper: [0.4, -0.3]", "upper: [1.0000000000001, -0.3]")));
+  EXPECT_EQ(scene.regions[1].upper[0], 1.0000000000001);
+}
+
+TEST_F(SceneTest, EveryMaterialKindAndModelTypeIsAccepted)
+{
+  const std::string materials = R"(  materials:
+    water: {kind: fluid, equation_of_state: {type: tait, reference_density: 1000, bulk_modulus: 2.2e9}, viscosity: 1.0e-3, specific_heat: 4180}
+    oil: {kind: fluid, equation_of_state: {type: linear_water, bulk_modulus: 1.5e9, reference_density: 850}, viscosity: 0.05, specific_heat: 1900}
+    air: {kind: fluid, equation_of_state: {type: ideal_gas, gas_constant: 287, gamma: 1.4}, viscosity: 1.8e-5, specific_heat: 717.5}
+    steel: {kind: solid, density: 7800, model: {type: linear_elastic, youngs_modulus: 2.0e11, poisson_ratio: 0.3}}
+    rubber: {kind: solid, density: 1100, model: {type: neo_hookean, bulk_modulus: 2.0e9, shear_modulus: 1.0e6}}
+    soil: {kind: solid, density: 1900, model: {type: drucker_prager, youngs_modulus: 1.0e7, poisson_ratio: 0.3, friction_angle: 30, dilatancy_angle: 5, fit: outer_cone}}
+    clay: {kind: solid, density: 1800, model: {type: tresca, youngs_modulus: 1.0e7, poisson_ratio: 0.45, yield_stress: 1.0e3}}
+    wall: {kind: solid, density: 2500, model: {type: rigid, velocity: [0.1, 0]}}
+)";
+  const std::string text = replaced(kMinimalScene, R"(  materials:
+    air:
+      kind: fluid
+      equation_of_state: {type: ideal_gas}
+      viscosity: 0
+)",
+                                    materials);
+  const Scene scene = readScene(write(text));
+  ASSERT_EQ(scene.materials.size(), 8u);
+  const auto& water_eos = scene.materials[0].parameters.sublist("equation_of_state");
+  EXPECT_EQ(water_eos.get<double>("exponent"), 7.0);
+  EXPECT_EQ(water_eos.get<double>("reference_pressure"), 101325.0);
+  const auto& oil_eos = scene.materials[1].parameters.sublist("equation_of_state");
+  EXPECT_EQ(oil_eos.get<double>("reference_temperature"), 293.15);
+  EXPECT_EQ(oil_eos.get<double>("thermal_expansion"), 0.0);
+  const auto& soil = scene.materials[5].parameters.sublist("model");
+  EXPECT_EQ(soil.get<double>("cohesion"), 0.0);
+  EXPECT_EQ(soil.get<std::string>("fit"), "outer_cone");
+  EXPECT_EQ(scene.materials[5].parameters.get<int>("particles_per_cell"), 2);
+  EXPECT_EQ(scene.materials[7].parameters.sublist("model").get<Array<double>>("velocity"), Array<double>(Teuchos::tuple(0.1, 0.0)));
+}
+
+TEST_F(SceneTest, CommentsDirectivesAndDocumentMarkersAroundTheRootAreAllowed)
+{
+  const Scene scene = readScene(write("%YAML 1.1\n---\n# comment\n" + kMinimalScene + "...\n"));
+  EXPECT_EQ(scene.domain.cells[0], 40);
+}
+
+}  // namespace
+}  // namespace cfdmpm::test

@@ -1,0 +1,528 @@
+// The implicit pressure solve: graph and matrix (Tpetra), CG (Belos), smoothed aggregation (MueLu).
+// This is the only translation unit that includes Belos and MueLu.
+#include "ice/pressure_solver.hpp"
+
+#include "common/error.hpp"
+
+#include <BelosLinearProblem.hpp>
+#include <BelosPseudoBlockCGSolMgr.hpp>
+#include <BelosTpetraAdapter.hpp>
+#include <MueLu_CreateTpetraPreconditioner.hpp>
+#include <Teuchos_CommHelpers.hpp>
+#include <Tpetra_CrsGraph.hpp>
+#include <Tpetra_CrsMatrix.hpp>
+#include <Tpetra_Vector.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+
+namespace cfdmpm {
+
+namespace {
+
+using MultiVector = Tpetra::MultiVector<Scalar, LocalOrdinal, GlobalOrdinal, Node>;
+using Vector = Tpetra::Vector<Scalar, LocalOrdinal, GlobalOrdinal, Node>;
+using Operator = Tpetra::Operator<Scalar, LocalOrdinal, GlobalOrdinal, Node>;
+using Graph = Tpetra::CrsGraph<LocalOrdinal, GlobalOrdinal, Node>;
+using CrsMatrix = Tpetra::CrsMatrix<Scalar, LocalOrdinal, GlobalOrdinal, Node>;
+using MueLuPreconditioner = MueLu::TpetraOperator<Scalar, LocalOrdinal, GlobalOrdinal, Node>;
+using Clock = std::chrono::steady_clock;
+
+enum class PreconditionerType { MueLu, Jacobi, None };
+enum class ReuseMode { KeepRP, KeepTentativeP, Frozen };
+
+double secondsSince(Clock::time_point start)
+{
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// The settings after validation, as typed values.
+struct Settings {
+  double tolerance = 1e-10;
+  int maximum_iterations = 500;
+  PreconditionerType preconditioner = PreconditionerType::MueLu;
+  int verbosity = 0;
+  int reuse_interval = 1;
+  ReuseMode reuse_mode = ReuseMode::KeepRP;
+};
+
+Settings readSettings(Teuchos::ParameterList& list, const Teuchos::ParameterList& valid)
+{
+  try {
+    // Depth 0: the "muelu" sublist is MueLu's to validate.
+    list.validateParametersAndSetDefaults(valid, 0);
+  } catch (const std::exception& e) {
+    throw InputError(std::string("pressure solver settings: ") + e.what());
+  }
+  Settings s;
+  s.tolerance = list.get<double>("tolerance");
+  if (!(s.tolerance > 0 && s.tolerance < 1))
+    throw inputError("pressure solver: tolerance", std::to_string(s.tolerance), "must lie in (0, 1)");
+  s.maximum_iterations = list.get<int>("maximum iterations");
+  if (s.maximum_iterations < 1)
+    throw inputError("pressure solver: maximum iterations", std::to_string(s.maximum_iterations), "must be >= 1");
+  const std::string preconditioner = list.get<std::string>("preconditioner");
+  if (preconditioner == "muelu") s.preconditioner = PreconditionerType::MueLu;
+  else if (preconditioner == "jacobi") s.preconditioner = PreconditionerType::Jacobi;
+  else if (preconditioner == "none") s.preconditioner = PreconditionerType::None;
+  else throw inputError("pressure solver: preconditioner", preconditioner, "allowed: muelu, jacobi, none");
+  s.verbosity = list.get<int>("verbosity");
+  if (s.verbosity < 0 || s.verbosity > 2)
+    throw inputError("pressure solver: verbosity", std::to_string(s.verbosity), "allowed: 0, 1, 2");
+  s.reuse_interval = list.get<int>("reuse interval");
+  if (s.reuse_interval < 1)
+    throw inputError("pressure solver: reuse interval", std::to_string(s.reuse_interval), "must be >= 1");
+  const std::string mode = list.get<std::string>("reuse mode");
+  if (mode == "RP") s.reuse_mode = ReuseMode::KeepRP;
+  else if (mode == "tP") s.reuse_mode = ReuseMode::KeepTentativeP;
+  else if (mode == "frozen") s.reuse_mode = ReuseMode::Frozen;
+  else throw inputError("pressure solver: reuse mode", mode, "allowed: RP, tP, frozen");
+  return s;
+}
+
+/// Jacobi preconditioner, y = beta y + alpha D^-1 x with D the matrix diagonal; kept only to show
+/// what MueLu buys (see doc/ice-pressure.md).
+class InverseDiagonal final : public Operator {
+ public:
+  explicit InverseDiagonal(const CrsMatrix& matrix) : inverse_(Teuchos::rcp(new Vector(matrix.getRowMap())))
+  {
+    update(matrix);
+  }
+  void update(const CrsMatrix& matrix)
+  {
+    matrix.getLocalDiagCopy(*inverse_);
+    inverse_->reciprocal(*inverse_);
+  }
+  Teuchos::RCP<const Map> getDomainMap() const override { return inverse_->getMap(); }
+  Teuchos::RCP<const Map> getRangeMap() const override { return inverse_->getMap(); }
+  void apply(const MultiVector& x, MultiVector& y, Teuchos::ETransp, Scalar alpha, Scalar beta) const override
+  {
+    y.elementWiseMultiply(alpha, *inverse_, x, beta);
+  }
+
+ private:
+  Teuchos::RCP<Vector> inverse_;
+};
+
+/// The face coefficient of every direction, readable inside a kernel: (d, c) is the value on the
+/// lower face of cell c in direction d.
+template <int Dim>
+struct LowerFaceValues {
+  typename Field<Dim>::ConstView direction[Dim];
+  KOKKOS_INLINE_FUNCTION Scalar operator()(int d, LocalOrdinal c) const { return direction[d](c, 0); }
+};
+
+void requireOneColumn(int columns, const std::string& name, const char* role)
+{
+  if (columns != 1)
+    throw std::invalid_argument("PressureSolver: " + std::string(role) + " '" + name + "' must have 1 column, has " +
+                                std::to_string(columns));
+}
+
+}  // namespace
+
+template <int Dim>
+struct PressureSolver<Dim>::Impl {
+  static constexpr int kStencil = 1 + 2 * Dim;  // slot 0: the cell; slot 1 + f: across face f
+
+  std::shared_ptr<const Layout<Dim>> layout;
+  Teuchos::ParameterList settings_list;
+  Settings settings;
+
+  Teuchos::RCP<CrsMatrix> matrix;
+  // (owned cell, slot) -> local column id in the matrix's column map; -1 across a wall.
+  Kokkos::View<LocalOrdinal**, MemorySpace> stencil_columns;
+  typename Kokkos::View<LocalOrdinal**, MemorySpace>::HostMirror stencil_columns_host;
+  Kokkos::View<Scalar**, MemorySpace> stencil_values;  // same shape; filled by assemble()
+
+  Teuchos::RCP<MueLuPreconditioner> muelu;
+  Teuchos::RCP<InverseDiagonal> jacobi;
+  bool assembled = false;
+  bool values_changed = false;  // since the preconditioner last saw the matrix
+  bool rebuild_requested = false;
+  int solves_since_setup = 0;
+
+  void buildGraph();
+  Teuchos::ParameterList mueluParameters() const;
+  Teuchos::RCP<Operator> preparePreconditioner(PressureSolveReport& report);
+  double residualNorm(const MultiVector& b, const MultiVector& x) const;
+  void runCG(const Teuchos::RCP<Operator>& preconditioner, const MultiVector& b, MultiVector& x, double b_norm,
+             PressureSolveReport& report) const;
+};
+
+template <int Dim>
+void PressureSolver<Dim>::Impl::buildGraph()
+{
+  const Layout<Dim>& lay = *layout;
+  if (lay.ghostWidth() < 1) throw std::invalid_argument("PressureSolver: the layout needs ghost width >= 1");
+  const LocalOrdinal owned = lay.ownedCells();
+  const Map& overlap = *lay.overlapCellMap();
+  const auto neighbours = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), lay.cellNeighbours());
+
+  // Global ids of each row's stencil (the cell first, then its face neighbours inside the domain).
+  std::vector<GlobalOrdinal> stencil_gids(std::size_t(owned) * kStencil, -1);
+  std::vector<std::size_t> entries(owned, 0);
+  for (LocalOrdinal c = 0; c < owned; ++c) {
+    stencil_gids[c * kStencil] = overlap.getGlobalElement(c);
+    entries[c] = 1;
+    for (int f = 0; f < 2 * Dim; ++f) {
+      const LocalOrdinal n = neighbours(c, f);
+      if (n == Layout<Dim>::kOutsideDomain) continue;  // wall: no coupling
+      if (n < 0) throw std::logic_error("PressureSolver: face neighbour of an owned cell is not local");
+      stencil_gids[c * kStencil + 1 + f] = overlap.getGlobalElement(n);
+      ++entries[c];
+    }
+  }
+
+  // Tpetra builds the column map from the global ids: owned cells plus the face-neighbour ghosts
+  // only, so the matrix-vector product imports no more than the stencil needs.
+  const Teuchos::RCP<const Map>& rows = lay.ownedCellMap();
+  auto graph = Teuchos::rcp(new Graph(rows, Teuchos::ArrayView<const std::size_t>(entries.data(), entries.size())));
+  for (LocalOrdinal c = 0; c < owned; ++c) {
+    GlobalOrdinal columns[kStencil];
+    int n = 0;
+    for (int s = 0; s < kStencil; ++s)
+      if (stencil_gids[c * kStencil + s] >= 0) columns[n++] = stencil_gids[c * kStencil + s];
+    graph->insertGlobalIndices(stencil_gids[c * kStencil], Teuchos::ArrayView<const GlobalOrdinal>(columns, n));
+  }
+  graph->fillComplete(rows, rows);
+
+  const Map& column_map = *graph->getColMap();
+  stencil_columns = Kokkos::View<LocalOrdinal**, MemorySpace>("pressure stencil columns", owned, kStencil);
+  stencil_columns_host = Kokkos::create_mirror_view(stencil_columns);
+  for (LocalOrdinal c = 0; c < owned; ++c)
+    for (int s = 0; s < kStencil; ++s) {
+      const GlobalOrdinal gid = stencil_gids[c * kStencil + s];
+      stencil_columns_host(c, s) = gid < 0 ? -1 : column_map.getLocalElement(gid);
+    }
+  Kokkos::deep_copy(stencil_columns, stencil_columns_host);
+  stencil_values = Kokkos::View<Scalar**, MemorySpace>("pressure stencil values", owned, kStencil);
+
+  matrix = Teuchos::rcp(new CrsMatrix(graph));
+  matrix->fillComplete(rows, rows);  // all zeros until the first assemble()
+}
+
+template <int Dim>
+Teuchos::ParameterList PressureSolver<Dim>::Impl::mueluParameters() const
+{
+  Teuchos::ParameterList p;
+  p.set("verbosity", std::string(settings.verbosity >= 2 ? "low" : "none"));
+  p.set("problem: symmetric", true);
+  p.set("multigrid algorithm", std::string("sa"));
+  p.set("smoother: type", std::string("CHEBYSHEV"));
+  // MueLu's default coarse solver (Amesos2 KLU2) diverges on more than one rank with Debian's
+  // Trilinos 13.2 (the coarse matrix stays distributed); ILUT on the coarse level works.
+  if (layout->comm()->getSize() > 1) p.set("coarse: type", std::string("ILUT"));
+  if (settings.reuse_interval > 1 && settings.reuse_mode != ReuseMode::Frozen)
+    p.set("reuse: type", std::string(settings.reuse_mode == ReuseMode::KeepRP ? "RP" : "tP"));
+  p.setParameters(settings_list.sublist("muelu"));  // the user's MueLu keys win
+  return p;
+}
+
+template <int Dim>
+Teuchos::RCP<Operator> PressureSolver<Dim>::Impl::preparePreconditioner(PressureSolveReport& report)
+{
+  switch (settings.preconditioner) {
+    case PreconditionerType::None:
+      return Teuchos::null;
+    case PreconditionerType::Jacobi:
+      if (jacobi.is_null()) jacobi = Teuchos::rcp(new InverseDiagonal(*matrix));
+      else if (values_changed) jacobi->update(*matrix);
+      values_changed = false;
+      return jacobi;
+    case PreconditionerType::MueLu:
+      break;
+  }
+  const bool rebuild = muelu.is_null() || rebuild_requested || solves_since_setup >= settings.reuse_interval;
+  if (rebuild) {
+    muelu = Teuchos::null;  // free the old hierarchy before building the new one
+    Teuchos::ParameterList parameters = mueluParameters();
+    muelu = MueLu::CreateTpetraPreconditioner(Teuchos::RCP<Operator>(matrix), parameters);
+    solves_since_setup = 0;
+    rebuild_requested = false;
+    report.preconditioner_rebuilt = true;
+  } else if (values_changed && settings.reuse_mode != ReuseMode::Frozen) {
+    // Keep the aggregates and the transfer operators (RP) or the tentative prolongator only (tP);
+    // recompute the rest (smoothed prolongators for tP, coarse matrices, smoothers).
+    MueLu::ReuseTpetraPreconditioner(matrix, *muelu);
+  }
+  // Frozen: the hierarchy built for older values is applied as it is (its finest level sees the
+  // current matrix, which MueLu holds by reference).
+  values_changed = false;
+  return muelu;
+}
+
+template <int Dim>
+double PressureSolver<Dim>::Impl::residualNorm(const MultiVector& b, const MultiVector& x) const
+{
+  MultiVector r(b, Teuchos::Copy);
+  matrix->apply(x, r, Teuchos::NO_TRANS, -1.0, 1.0);  // r = b - A x
+  double norm = 0;
+  r.norm2(Teuchos::ArrayView<double>(&norm, 1));
+  return norm;
+}
+
+/// Belos CG on A x = b from the current x, adding to the report. Belos's stopping test uses the
+/// recurrence residual, which can drift from the true one; if they disagree we restart from the
+/// current iterate (a restart recomputes the residual), at most twice, within the iteration budget.
+template <int Dim>
+void PressureSolver<Dim>::Impl::runCG(const Teuchos::RCP<Operator>& preconditioner, const MultiVector& b,
+                                      MultiVector& x, double b_norm, PressureSolveReport& report) const
+{
+  auto problem = Teuchos::rcp(new Belos::LinearProblem<Scalar, MultiVector, Operator>(
+      matrix, Teuchos::rcpFromRef(x), Teuchos::rcpFromRef(b)));
+  if (!preconditioner.is_null()) problem->setLeftPrec(preconditioner);
+  int verbosity = Belos::Errors + Belos::Warnings;
+  if (settings.verbosity >= 2) verbosity += Belos::IterationDetails + Belos::FinalSummary + Belos::StatusTestDetails;
+  int iterations = 0;
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    auto belos = Teuchos::rcp(new Teuchos::ParameterList);
+    belos->set("Convergence Tolerance", settings.tolerance);
+    belos->set("Maximum Iterations", settings.maximum_iterations - iterations);
+    belos->set("Implicit Residual Scaling", std::string("Norm of RHS"));  // relative to ||b||, not ||r0||
+    belos->set("Verbosity", verbosity);
+    belos->set("Output Style", int(Belos::Brief));
+    belos->set("Output Frequency", settings.verbosity >= 2 ? 1 : -1);
+    problem->setProblem();  // residual of the current iterate
+    Belos::PseudoBlockCGSolMgr<Scalar, MultiVector, Operator> cg(problem, belos);
+    Belos::ReturnType result = Belos::Unconverged;
+    try {
+      result = cg.solve();
+    } catch (const std::exception& e) {  // loss of positive definiteness, for one
+      report.failure = e.what();
+    }
+    iterations += cg.getNumIters();
+    report.relative_residual = residualNorm(b, x) / b_norm;
+    report.converged = report.relative_residual <= settings.tolerance;
+    if (report.converged || result != Belos::Converged || iterations >= settings.maximum_iterations) break;
+  }
+  report.iterations += iterations;
+}
+
+template <int Dim>
+PressureSolver<Dim>::PressureSolver(std::shared_ptr<const Layout<Dim>> layout, const Teuchos::ParameterList& settings)
+    : impl_(std::make_unique<Impl>())
+{
+  impl_->layout = std::move(layout);
+  impl_->settings_list = settings;
+  impl_->settings = readSettings(impl_->settings_list, *validParameters());
+  impl_->buildGraph();
+}
+
+template <int Dim>
+PressureSolver<Dim>::~PressureSolver() = default;
+
+template <int Dim>
+Teuchos::RCP<const Teuchos::ParameterList> PressureSolver<Dim>::validParameters()
+{
+  auto p = Teuchos::rcp(new Teuchos::ParameterList("pressure solver"));
+  p->set("tolerance", 1e-10, "CG stops when ||rhs - A dp|| / ||rhs|| is below this (checked with the true residual)");
+  p->set("maximum iterations", 500,
+         "CG iterations at most per preconditioner (a fresh one replacing a failed reused one gets its own)");
+  p->set("preconditioner", std::string("muelu"),
+         "muelu (smoothed aggregation, Chebyshev smoother), jacobi or none (the last two for comparison)");
+  p->set("verbosity", 0, "0 quiet; 1 one line per solve on rank 0; 2 also Belos iterations and MueLu setup");
+  p->set("reuse interval", 1, "a full MueLu setup every N solves (1: every solve)");
+  p->set("reuse mode", std::string("RP"),
+         "between full setups: RP keeps aggregates, prolongators and restrictions and recomputes the coarse "
+         "matrices and smoothers; tP keeps the tentative prolongator only; frozen reuses the old hierarchy");
+  p->sublist("muelu", false, "MueLu parameters applied on top of cfdmpm's defaults");
+  return p;
+}
+
+template <int Dim>
+const Teuchos::ParameterList& PressureSolver<Dim>::settings() const
+{
+  return impl_->settings_list;
+}
+
+template <int Dim>
+const Layout<Dim>& PressureSolver<Dim>::layout() const
+{
+  return *impl_->layout;
+}
+
+template <int Dim>
+Teuchos::RCP<const typename PressureSolver<Dim>::Matrix> PressureSolver<Dim>::matrix() const
+{
+  return impl_->matrix;
+}
+
+template <int Dim>
+void PressureSolver<Dim>::requestPreconditionerRebuild()
+{
+  impl_->rebuild_requested = true;
+}
+
+template <int Dim>
+void PressureSolver<Dim>::assemble(const Field<Dim>& mixture_compressibility, FaceField<Dim>& face_coefficient,
+                                   double dt)
+{
+  Impl& m = *impl_;
+  const Layout<Dim>& lay = *m.layout;
+  requireOneColumn(mixture_compressibility.columns(), mixture_compressibility.name(), "compressibility");
+  for (int d = 0; d < Dim; ++d)
+    requireOneColumn(face_coefficient.direction(d).columns(), face_coefficient.direction(d).name(), "face coefficient");
+  if (!(dt > 0 && std::isfinite(dt))) throw std::invalid_argument("PressureSolver: dt must be > 0, got " + std::to_string(dt));
+
+  // The upper face of an owned cell is the lower face of its neighbour, possibly a ghost.
+  face_coefficient.exchangeHalo();
+
+  // Kashiwa / Uintah impICE: a_nbr = -dt^2 (A_f / h_f) beta_f, a_cc = V kappa_c + sum_f dt^2 (A_f / h_f) beta_f.
+  const double volume = lay.grid().cellVolume();
+  double face_weight[3] = {0, 0, 0};  // dt^2 A_f / h_f = dt^2 V / h_d^2 per direction
+  for (int d = 0; d < Dim; ++d) face_weight[d] = dt * dt * volume / (lay.grid().spacing()[d] * lay.grid().spacing()[d]);
+  const double wx = face_weight[0], wy = face_weight[1], wz = face_weight[2];
+
+  const auto kappa = mixture_compressibility.view();
+  LowerFaceValues<Dim> beta;
+  for (int d = 0; d < Dim; ++d) beta.direction[d] = face_coefficient.direction(d).view();
+  const auto neighbours = lay.cellNeighbours();
+  const auto values = m.stencil_values;
+  const LocalOrdinal owned = lay.ownedCells();
+
+  // The first owned cell with a bad coefficient (owned when there is none).
+  LocalOrdinal first_bad = owned;
+  Kokkos::parallel_reduce(
+      "pressure matrix values", Kokkos::RangePolicy<ExecutionSpace>(0, owned),
+      KOKKOS_LAMBDA(const LocalOrdinal c, LocalOrdinal& bad) {
+        const double weight[3] = {wx, wy, wz};
+        double diagonal = volume * kappa(c, 0);
+        bool ok = kappa(c, 0) > 0 && kappa(c, 0) < INFINITY;
+        for (int f = 0; f < 2 * Dim; ++f) {
+          const LocalOrdinal n = neighbours(c, f);
+          if (n < 0) {  // wall: zero normal gradient, no flux
+            values(c, 1 + f) = 0;
+            continue;
+          }
+          const int d = f / 2;
+          const double b = beta(d, f % 2 == 0 ? c : n);  // lower face of c, or of the upper neighbour
+          ok = ok && b >= 0 && b < INFINITY;
+          const double a = weight[d] * b;
+          values(c, 1 + f) = -a;
+          diagonal += a;
+        }
+        values(c, 0) = diagonal;
+        if (!ok && c < bad) bad = c;
+      },
+      Kokkos::Min<LocalOrdinal>(first_bad));
+
+  // A bad coefficient on any rank stops every rank (so none waits in a collective).
+  int local_bad = first_bad < owned ? 1 : 0, any_bad = 0;
+  Teuchos::reduceAll(*lay.comm(), Teuchos::REDUCE_MAX, local_bad, Teuchos::outArg(any_bad));
+  if (any_bad) {
+    std::ostringstream message;
+    message << "PressureSolver::assemble: ";
+    if (local_bad) {
+      const auto ijk = lay.grid().cellIndex(lay.ownedCellMap()->getGlobalElement(first_bad));
+      message << "cell (" << ijk[0] << ", " << ijk[1] << ", " << ijk[2] << ") has compressibility "
+              << kappa(first_bad, 0) << " 1/Pa (must be > 0) or a face coefficient that is negative or not finite";
+    } else {
+      message << "a bad coefficient on another rank";
+    }
+    throw std::runtime_error(message.str());
+  }
+
+  // Replace the values in the fixed graph.
+  const auto values_host = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), values);
+  const auto& columns = m.stencil_columns_host;
+  m.matrix->resumeFill();
+  long long replaced = 0, expected = 0;
+  for (LocalOrdinal c = 0; c < owned; ++c) {
+    LocalOrdinal row_columns[Impl::kStencil];
+    Scalar row_values[Impl::kStencil];
+    LocalOrdinal n = 0;
+    for (int s = 0; s < Impl::kStencil; ++s)
+      if (columns(c, s) >= 0) {
+        row_columns[n] = columns(c, s);
+        row_values[n] = values_host(c, s);
+        ++n;
+      }
+    replaced += m.matrix->replaceLocalValues(c, n, row_values, row_columns);
+    expected += n;
+  }
+  m.matrix->fillComplete(lay.ownedCellMap(), lay.ownedCellMap());
+  if (replaced != expected)
+    throw std::logic_error("PressureSolver::assemble: replaced " + std::to_string(replaced) + " of " +
+                           std::to_string(expected) + " matrix entries");
+  m.assembled = true;
+  m.values_changed = true;
+}
+
+template <int Dim>
+void PressureSolver<Dim>::apply(const Field<Dim>& x, Field<Dim>& y) const
+{
+  if (!impl_->assembled) throw std::logic_error("PressureSolver::apply before assemble");
+  requireOneColumn(x.columns(), x.name(), "x");
+  requireOneColumn(y.columns(), y.name(), "y");
+  impl_->matrix->apply(x.owned(), y.owned());
+}
+
+template <int Dim>
+PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>& solution)
+{
+  Impl& m = *impl_;
+  if (!m.assembled) throw std::logic_error("PressureSolver::solve before assemble");
+  requireOneColumn(rhs.columns(), rhs.name(), "rhs");
+  requireOneColumn(solution.columns(), solution.name(), "solution");
+  const Settings& s = m.settings;
+  PressureSolveReport report;
+
+  const MultiVector& b = rhs.owned();
+  MultiVector& x = solution.owned();
+  double b_norm = 0;
+  b.norm2(Teuchos::ArrayView<double>(&b_norm, 1));
+  if (b_norm == 0) {  // A is SPD, so the answer is exactly zero
+    x.putScalar(0);
+    solution.exchangeHalo();
+    report.converged = true;
+    return report;
+  }
+
+  // 1. Preconditioner: built, refreshed or reused.
+  Clock::time_point start = Clock::now();
+  Teuchos::RCP<Operator> preconditioner = m.preparePreconditioner(report);
+  report.setup_seconds = secondsSince(start);
+  const bool reused = s.preconditioner == PreconditionerType::MueLu && !report.preconditioner_rebuilt;
+  const Teuchos::RCP<MultiVector> guess = reused ? Teuchos::rcp(new MultiVector(x, Teuchos::Copy)) : Teuchos::null;
+
+  // 2. CG from the caller's guess.
+  start = Clock::now();
+  m.runCG(preconditioner, b, x, b_norm, report);
+  report.solve_seconds = secondsSince(start);
+
+  // 3. A reused hierarchy may no longer suit the matrix (a frozen Chebyshev smoother that meets
+  //    changed coefficients can make the preconditioner indefinite and CG break down): build a
+  //    fresh one and start again from the caller's guess.
+  if (!report.converged && reused) {
+    m.rebuild_requested = true;
+    start = Clock::now();
+    preconditioner = m.preparePreconditioner(report);
+    report.setup_seconds += secondsSince(start);
+    start = Clock::now();
+    x.assign(*guess);
+    report.failure.clear();
+    m.runCG(preconditioner, b, x, b_norm, report);
+    report.solve_seconds += secondsSince(start);
+  }
+  solution.exchangeHalo();
+  ++m.solves_since_setup;
+
+  if (s.verbosity >= 1 && m.layout->comm()->getRank() == 0) {
+    std::cout << "pressure solve: " << report.iterations << " CG iterations, relative residual "
+              << std::scientific << std::setprecision(2) << report.relative_residual << std::defaultfloat
+              << (report.converged ? "" : " (NOT CONVERGED)") << ", setup " << report.setup_seconds << " s"
+              << (report.preconditioner_rebuilt ? " (new preconditioner)" : "") << ", solve "
+              << report.solve_seconds << " s\n";
+  }
+  return report;
+}
+
+template class PressureSolver<2>;
+template class PressureSolver<3>;
+
+}  // namespace cfdmpm

@@ -1,0 +1,100 @@
+#pragma once
+// The implicit pressure equation of the ICE step (Kashiwa's cell-centred ICE; Uintah impICE): per
+// owned cell c of volume V, for the pressure correction δp,
+//
+//   V κ_c δp_c − Δt² Σ_faces (A_f / h_f) β_f (δp_neighbour − δp_c) = rhs_c,   β_f = Σ_m θ_f,m v_f,m
+//
+// with κ_c = Σ_m θ_m κ_m the mixture compressibility (1/Pa), A_f the face area, h_f the cell spacing
+// normal to the face and β_f (m^3/kg) the face sum of volume fraction times specific volume. Domain
+// faces are walls: no flux (zero normal gradient of δp). The matrix is symmetric positive definite
+// when κ > 0 and β ≥ 0; it is solved with Belos CG preconditioned by MueLu smoothed aggregation.
+//
+// The sparsity graph is built once per layout; assemble() only replaces values, and solve() builds
+// or reuses the preconditioner. See doc/ice-pressure.md for the matrix entries and the settings.
+//
+// Belos and MueLu are confined to pressure_solver.cpp (they are costly to compile); this header
+// only forward-declares the matrix type.
+#include "fields/field.hpp"
+#include "ice/face_field.hpp"
+
+#include <Teuchos_ParameterList.hpp>
+#include <Teuchos_RCP.hpp>
+#include <Tpetra_CrsMatrix_fwd.hpp>
+
+#include <memory>
+#include <string>
+
+namespace cfdmpm {
+
+/// What one pressure solve did. `converged` is true only when the true relative residual
+/// ||b − A x|| / ||b||, computed after the solve, is at most the tolerance; the caller decides what
+/// to do with an unconverged answer (Uintah restarts the time step with a smaller Δt).
+struct PressureSolveReport {
+  int iterations = 0;                   // CG iterations, summed over restarts and a fallback setup
+  double relative_residual = 0;         // true residual ||b − A x|| / ||b|| (0 when b = 0)
+  bool converged = false;
+  bool preconditioner_rebuilt = false;  // a full MueLu setup happened in this solve (scheduled,
+                                        // requested, or after a solve with a reused one failed)
+  double setup_seconds = 0;             // preconditioner setup (full or reuse), this rank's wall time
+  double solve_seconds = 0;             // CG iterations and the true-residual check
+  std::string failure;                  // why Belos stopped, when it threw; empty otherwise
+};
+
+template <int Dim>
+class PressureSolver {
+ public:
+  using Matrix = Tpetra::CrsMatrix<Scalar, LocalOrdinal, GlobalOrdinal, Node>;
+
+  /// Builds the 5-point (2-D) or 7-point (3-D) graph on the layout's owned cells. `settings` is
+  /// checked against validParameters() (unknown keys and bad values throw InputError); missing
+  /// keys take their defaults. The layout needs a ghost width of at least 1.
+  PressureSolver(std::shared_ptr<const Layout<Dim>> layout,
+                 const Teuchos::ParameterList& settings = Teuchos::ParameterList());
+  ~PressureSolver();
+  PressureSolver(const PressureSolver&) = delete;
+  PressureSolver& operator=(const PressureSolver&) = delete;
+
+  /// The accepted settings with their defaults and documentation:
+  ///   "tolerance" (1e-10, relative to ||rhs||), "maximum iterations" (500, per preconditioner),
+  ///   "preconditioner" ("muelu" | "jacobi" | "none"), "verbosity" (0 quiet, 1 one line per solve,
+  ///   2 plus Belos and MueLu output), "reuse interval" (1: a full MueLu setup every solve; N: every
+  ///   N solves), "reuse mode" ("RP" | "tP" | "frozen": what happens between full setups), and a
+  ///   sublist "muelu" passed to MueLu on top of cfdmpm's defaults.
+  static Teuchos::RCP<const Teuchos::ParameterList> validParameters();
+  /// The settings in use, defaults filled in.
+  const Teuchos::ParameterList& settings() const;
+
+  /// Fills the matrix values for this step (the graph is not rebuilt).
+  ///   mixture_compressibility: κ_c (1/Pa), 1 column, owned cells read; must be > 0.
+  ///   face_coefficient: β_f (m^3/kg), 1 column, on the lower face of each cell (face_field.hpp);
+  ///     must be >= 0. Its halo is exchanged here, because the upper face of an owned cell is the
+  ///     lower face of its neighbour, which may live on another rank.
+  ///   dt: the time step (s).
+  /// Throws std::runtime_error on every rank if any rank finds a bad coefficient.
+  void assemble(const Field<Dim>& mixture_compressibility, FaceField<Dim>& face_coefficient, double dt);
+
+  /// Solves A δp = rhs. `solution` holds the initial guess on entry (warm start) and the answer on
+  /// return, with its ghost entries exchanged. Both fields have 1 column; owned rows of rhs are read.
+  /// Never throws for an unconverged solve: see the report. When a solve with a reused MueLu
+  /// hierarchy fails, a fresh hierarchy is built and the solve repeated from the initial guess.
+  PressureSolveReport solve(const Field<Dim>& rhs, Field<Dim>& solution);
+
+  /// y = A x on the owned cells (x's ghosts are not read; y's ghosts are not written).
+  void apply(const Field<Dim>& x, Field<Dim>& y) const;
+
+  /// The next solve does a full preconditioner setup, whatever the reuse interval.
+  void requestPreconditionerRebuild();
+
+  /// The assembled matrix (rows: owned cells; column map built by Tpetra from the stencil).
+  Teuchos::RCP<const Matrix> matrix() const;
+  const Layout<Dim>& layout() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+extern template class PressureSolver<2>;
+extern template class PressureSolver<3>;
+
+}  // namespace cfdmpm

@@ -1,0 +1,94 @@
+#pragma once
+// Advection of the fluid materials' conserved cell quantities by the face velocities: the last
+// phase of the ICE step (Uintah's advectAndAdvanceInTime with the SecondOrder advector and
+// compatible fluxes). Per material, the mass and any number of mass-specific quantities q (velocity,
+// specific volume, internal energy per mass, ...) move through the cell faces with
+//
+//   mass flux   F_f   = V_f · ρ̃(x_f)            (V_f: outflow slab volume of the donor, ρ̃: limited
+//                                                linear density of the donor, x_f: slab centroid)
+//   flux of M q       = F_f · q̃(x_f)            (q̃: limited linear q of the donor)
+//
+// so that mass and every M q are conserved to round-off, the density stays >= 0 (and within its
+// neighbours' bounds in a divergence-free flow), and each q stays within the bounds of the values
+// it is mixed from, in any flow. The scheme, the limiter and the measured orders are in
+// doc/ice-advection.md.
+#include "fields/field.hpp"
+#include "ice/face_field.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace cfdmpm {
+
+/// Result of one advection step. The step is refused (fields unchanged) when some cell would send
+/// out more than its volume in one step (Uintah's "bulletproofing"): the caller reduces Δt.
+struct AdvectionStatus {
+  bool ok = true;
+  /// Largest Σ_faces V_out / V_cell over all cells and materials (the outflow Courant number).
+  double max_outflux_fraction = 0.0;
+  long long cell = -1;  // global id of the cell where the maximum occurs (lowest id on ties)
+  int material = -1;    // and its material
+  std::string message() const;
+};
+
+template <int Dim>
+class Advector {
+ public:
+  struct Options {
+    /// Evaluate each slab at the centroid of the region swept through the face in Δt, shifted by
+    /// the donor's mean transverse velocity (corner transport). Off: the centroid of the
+    /// rectangular slab, as Uintah; then diagonal flows are first order in time (see the doc).
+    bool transverse_correction = true;
+  };
+
+  /// Work arrays for `materials` materials on the layout's cells are allocated here, once.
+  Advector(std::shared_ptr<const Layout<Dim>> layout, int materials, Options options);
+  Advector(std::shared_ptr<const Layout<Dim>> layout, int materials)
+      : Advector(std::move(layout), materials, Options{})
+  {
+  }
+
+  /// Advances by dt (s):
+  /// - face_velocity (m/s): one column per material, the convention of face_field.hpp; every domain
+  ///   face is a wall (its flux is zero whatever the stored value). Its ghosts are refreshed here.
+  /// - mass (kg per cell, one column per material), updated in place. The scheme is linear in the
+  ///   mass, so a bulk density (mass / V_cell) may be passed instead and stays a bulk density.
+  /// - mass_specific: quantities per unit mass, each with `materials × k` columns, column m·k + j
+  ///   for component j of material m (k = 1 for scalars, k = Dim for a velocity as in CellState).
+  ///   Updated in place so that (M q)_new = M q + Σ fluxes of M q.
+  /// Input ghosts are refreshed before the step and output ghosts after it. If the status is not
+  /// ok, nothing is changed.
+  AdvectionStatus advect(FaceField<Dim>& face_velocity, double dt, Field<Dim>& mass,
+                         const std::vector<Field<Dim>*>& mass_specific);
+
+  /// The outflow Courant check alone (max over cells and materials of Σ V_out / V_cell), without
+  /// refreshing the face velocity's ghosts.
+  AdvectionStatus checkOutflux(const FaceField<Dim>& face_velocity, double dt) const;
+
+  int materials() const { return materials_; }
+
+  using WorkView = Kokkos::View<double***, MemorySpace>;  // (local cell, face, material)
+
+ private:
+  void reconstructMass(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass);
+  void reconstructQuantity(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass,
+                           const Field<Dim>& quantity, int components, int component);
+  void computeNewMass(const Field<Dim>& mass);
+  void updateQuantity(Field<Dim>& quantity, int components, int component);
+  void writeNewMass(Field<Dim>& mass);
+
+  std::shared_ptr<const Layout<Dim>> layout_;
+  int materials_;
+  Options options_;
+  // Per local cell (owned and ghost), face f = 2 d + side and material: the mass leaving the cell
+  // through f in this step (>= 0), and the value of the quantity being advected in that slab.
+  WorkView outflow_mass_, outflow_value_;
+  // Per owned cell and material: the new mass (written last) and the new value of one column.
+  Kokkos::View<double**, MemorySpace> new_mass_, new_value_;
+};
+
+extern template class Advector<2>;
+extern template class Advector<3>;
+
+}  // namespace cfdmpm

@@ -1,5 +1,6 @@
 #include "mpmice/simulation.hpp"
 
+#include "ice/ice_solver.hpp"
 #include "ice/material_eos.hpp"
 #include "io/output_directory.hpp"
 #include "io/progress.hpp"
@@ -22,18 +23,43 @@ MPI_Comm rawComm(const Teuchos::RCP<const Teuchos::Comm<int>>& comm)
   return *Teuchos::rcp_dynamic_cast<const Teuchos::MpiComm<int>>(comm, true)->getRawMpiComm();
 }
 
-/// Mass of every material over the whole domain (kg, or kg/m in 2-D).
+/// Conserved quantities per material over the whole domain (per metre of depth in 2-D): mass (kg),
+/// momentum components (kg m/s) and kinetic energy (J), in the order of conservedColumns().
 template <int Dim>
-std::vector<double> materialMasses(const CellState<Dim>& state)
+std::vector<double> conservedQuantities(const CellState<Dim>& state)
 {
   const auto rho = state.density.view();
+  const auto u = state.velocity.view();
   const double volume = state.density.layout().grid().cellVolume();
-  std::vector<double> local(state.materials, 0.0), total(state.materials, 0.0);
+  const int per_material = Dim + 2;
+  std::vector<double> local(state.materials * per_material, 0.0), total(local.size(), 0.0);
   for (LocalOrdinal c = 0; c < state.density.ownedCount(); ++c)
-    for (int m = 0; m < state.materials; ++m) local[m] += rho(c, m) * volume;
-  Teuchos::reduceAll(*state.density.layout().comm(), Teuchos::REDUCE_SUM, state.materials, local.data(),
+    for (int m = 0; m < state.materials; ++m) {
+      const double mass = rho(c, m) * volume;
+      double speed2 = 0;
+      local[m * per_material] += mass;
+      for (int d = 0; d < Dim; ++d) {
+        const double ud = u(c, CellState<Dim>::velocityColumn(m, d));
+        local[m * per_material + 1 + d] += mass * ud;
+        speed2 += ud * ud;
+      }
+      local[m * per_material + 1 + Dim] += 0.5 * mass * speed2;
+    }
+  Teuchos::reduceAll(*state.density.layout().comm(), Teuchos::REDUCE_SUM, int(local.size()), local.data(),
                      total.data());
   return total;
+}
+
+template <int Dim>
+std::vector<std::string> conservedColumns(const Scene& scene)
+{
+  std::vector<std::string> columns;
+  for (const auto& m : scene.materials) {
+    columns.push_back("mass_" + m.name);
+    for (int d = 0; d < Dim; ++d) columns.push_back(std::string("momentum_") + "xyz"[d] + "_" + m.name);
+    columns.push_back("kinetic_energy_" + m.name);
+  }
+  return columns;
 }
 
 template <int Dim>
@@ -52,22 +78,35 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
               << (Dim == 3 ? " x " + std::to_string(grid.cells()[2]) : std::string()) << " cells, "
               << grid.patchCount() << " patches on " << comm->getSize() << " rank(s)\n";
 
-  // 2. The initial state from the scene's regions and the materials' equations of state.
+  // 2. The initial state from the scene's regions and the materials' equations of state, and the
+  //    fluid solver (its settings are checked here, before any output). Solid materials need the
+  //    particle solver, which this version does not couple yet: such scenes stop after step 0.
   CellState<Dim> state(layout, int(scene.materials.size()));
   setInitialState(scene, densityFunctions(scene), state);
+  bool fluids_only = true;
+  for (const auto& m : scene.materials) fluids_only = fluids_only && m.kind == "fluid";
+  std::unique_ptr<IceSolver<Dim>> ice;
+  if (fluids_only) {
+    ice = std::make_unique<IceSolver<Dim>>(scene, layout);
+    const int failures = ice->equilibrate(state);
+    if (failures > 0)
+      throw std::runtime_error("initial equilibration pressure failed in " + std::to_string(failures) + " cells");
+  }
 
   // 3. Output: the directory (refused if it holds an earlier run, unless overwrite), the fields of
   //    step 0, and the diagnostics time series.
   prepareOutputDirectory(mpi, scene.output.directory, options.overwrite || scene.output.overwrite);
   const std::string run_name = std::filesystem::path(scene.path).stem().string();
   StateOutput<Dim> output(scene, *layout, run_name);
-  std::vector<std::string> columns{"step", "time", "dt", "dt_limiter"};
-  for (const auto& m : scene.materials) columns.push_back("mass_" + m.name);
+  std::vector<std::string> columns{"step", "time", "dt", "dt_limiter", "outer_iterations",
+                                   "pressure_iterations", "outer_residual", "max_outflux_fraction"};
+  for (const std::string& c : conservedColumns<Dim>(scene)) columns.push_back(c);
   const std::string csv_path = scene.output.directory + "/" + run_name + ".csv";
   CsvTimeSeries diagnostics(mpi, csv_path, columns);
-  auto report = [&](long long step, double time, double dt, const std::string& limiter) {
-    std::vector<CsvValue> row{step, time, dt, limiter};
-    for (double mass : materialMasses(state)) row.emplace_back(mass);
+  auto report = [&](long long step, double time, double dt, const std::string& limiter, const IceStepReport& r) {
+    std::vector<CsvValue> row{step, time, dt, limiter, r.outer_iterations, r.linear_iterations, r.outer_residual,
+                              r.max_outflux_fraction};
+    for (double q : conservedQuantities(state)) row.emplace_back(q);
     diagnostics.append(row);
   };
 
@@ -76,16 +115,51 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
   summary.output_directory = scene.output.directory;
   summary.diagnostics = csv_path;
   const std::string first = output.write(0, 0.0, state);
-  report(0, 0.0, 0.0, "initial");
+  report(0, 0.0, 0.0, "initial", IceStepReport{});
   if (root) std::cout << "  wrote initial state: " << first << "\n";
-
-  // 4. The time loop. The fluid (ICE) and particle (MPM) steps are not part of this version: the run
-  //    sets up the scene and writes its initial state.
-  if (root)
-    std::cout << "  no time integration in this version (fluid and particle solvers in progress): "
-                 "stopping after the initial state\n";
   summary.time_series = output.seriesPath();
-  summary.stopped_by_signal = stopRequested(mpi);
+  if (!ice) {
+    if (root)
+      std::cout << "  the scene has solid materials; the particle solver is not coupled in this version: "
+                   "stopping after the initial state\n";
+    return summary;
+  }
+
+  // 4. The time loop: Δt from the solver's limits, clipped to land on output times and the end.
+  const double end = scene.time.end_time;
+  const double interval = scene.output.interval;
+  double next_output = interval > 0 ? interval : end;
+  double t = 0, dt_previous = 0;
+  long long step = 0;
+  ProgressReporter progress(mpi, 0.0, end, scene.output.progress_interval);
+  const double eps = 1e-12 * end;
+  while (t < end - eps && (scene.time.max_steps < 0 || step < scene.time.max_steps)) {
+    TimeStepLimit limit = step == 0 ? TimeStepLimit{scene.time.dt_initial, "dt_initial"}
+                                    : ice->stableTimeStep(state, dt_previous);
+    dt_previous = limit.dt;
+    double dt = limit.dt;
+    if (t + dt > next_output - eps) {
+      dt = next_output - t;
+      limit.limiter += "+output";
+    }
+    const IceStepReport r = ice->step(state, dt);
+    t = (t + dt > next_output - eps) ? next_output : t + dt;
+    ++step;
+    report(step, t, dt, limit.limiter, r);
+    const bool stop = stopRequested(mpi);
+    const bool last = t >= end - eps || stop || (scene.time.max_steps >= 0 && step >= scene.time.max_steps);
+    if (t >= next_output - eps || last) {
+      output.write(step, t, state);
+      next_output = std::min(end, next_output + (interval > 0 ? interval : end));
+    }
+    progress.update(step, t, dt, last);
+    if (stop) {
+      summary.stopped_by_signal = true;
+      break;
+    }
+  }
+  summary.steps = step;
+  summary.time = t;
   return summary;
 }
 

@@ -1,0 +1,576 @@
+#include "ice/ice_solver.hpp"
+
+#include "ice/equilibration.hpp"
+#include "ice/exchange.hpp"
+#include "ice/material_eos.hpp"
+
+#include <Teuchos_TimeMonitor.hpp>
+
+#include <cfloat>
+#include <cmath>
+#include <sstream>
+
+namespace cfdmpm {
+
+namespace {
+
+constexpr double kTiny = 1e-100;  // guards divisions by a vanishing mass or density
+
+// A material holding less than this share of a cell's mass has no velocity of its own: it moves
+// with the mixture (its own momentum equation would divide by a vanishing mass).
+constexpr double kNegligibleMassShare = 1e-12;
+
+template <class T>
+T getOr(const Teuchos::ParameterList& list, const std::string& key, T fallback)
+{
+  return list.isParameter(key) ? list.get<T>(key) : fallback;
+}
+
+double number(const Teuchos::ParameterList& list, const std::string& key, double fallback)
+{
+  if (!list.isParameter(key)) return fallback;
+  if (list.isType<int>(key)) return double(list.get<int>(key));
+  if (list.isType<double>(key)) return list.get<double>(key);
+  throw InputError("cfdmpm.ice." + key + ": got a " + list.getEntry(key).getAny().typeName() +
+                   "; expected a number");
+}
+
+}  // namespace
+
+IceSettings IceSettings::fromScene(const Scene& scene)
+{
+  IceSettings s;
+  const Teuchos::ParameterList& ice = scene.parameters->isSublist("ice") ? scene.parameters->sublist("ice")
+                                                                        : Teuchos::ParameterList();
+  static const char* known[] = {"pressure", "exchange_coefficient", "max_outer_iterations", "outer_tolerance",
+                                "solver_tolerance", "dt_growth", "linear_solver"};
+  for (auto it = ice.begin(); it != ice.end(); ++it) {
+    const std::string& key = ice.name(it);
+    bool ok = false;
+    for (const char* k : known) ok = ok || key == k;
+    if (!ok)
+      throw InputError("cfdmpm.ice." + key + ": unknown key; allowed keys in cfdmpm.ice: pressure, "
+                       "exchange_coefficient, max_outer_iterations, outer_tolerance, solver_tolerance, "
+                       "dt_growth, linear_solver");
+  }
+  s.pressure = getOr<std::string>(ice, "pressure", s.pressure);
+  if (s.pressure != "implicit" && s.pressure != "explicit")
+    throw inputError("cfdmpm.ice.pressure", s.pressure, "allowed: implicit, explicit");
+  s.exchange_coefficient = number(ice, "exchange_coefficient", s.exchange_coefficient);
+  if (!(s.exchange_coefficient >= 0))
+    throw inputError("cfdmpm.ice.exchange_coefficient", std::to_string(s.exchange_coefficient), "must be >= 0 (kg/(m^3 s))");
+  s.max_outer_iterations = int(number(ice, "max_outer_iterations", s.max_outer_iterations));
+  if (s.max_outer_iterations < 1)
+    throw inputError("cfdmpm.ice.max_outer_iterations", std::to_string(s.max_outer_iterations), "must be >= 1");
+  s.outer_tolerance = number(ice, "outer_tolerance", s.outer_tolerance);
+  if (!(s.outer_tolerance > 0))
+    throw inputError("cfdmpm.ice.outer_tolerance", std::to_string(s.outer_tolerance), "must be > 0 (1/s)");
+  s.solver_tolerance = number(ice, "solver_tolerance", s.solver_tolerance);
+  if (!(s.solver_tolerance > 0 && s.solver_tolerance < 1e-2))
+    throw inputError("cfdmpm.ice.solver_tolerance", std::to_string(s.solver_tolerance), "must be in (0, 0.01)");
+  s.dt_growth = number(ice, "dt_growth", s.dt_growth);
+  if (!(s.dt_growth > 1))
+    throw inputError("cfdmpm.ice.dt_growth", std::to_string(s.dt_growth), "must be > 1");
+  if (ice.isSublist("linear_solver")) s.linear_solver = ice.sublist("linear_solver");
+  s.linear_solver.set("tolerance", s.solver_tolerance);
+  return s;
+}
+
+template <int Dim>
+IceSolver<Dim>::IceSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>> layout)
+    : scene_(scene),
+      settings_(IceSettings::fromScene(scene)),
+      layout_(layout),
+      materials_(int(scene.materials.size())),
+      compressibility_(layout, Location::Cell, materials_, "compressibility"),
+      mixture_compressibility_(layout, Location::Cell, 1, "mixture_compressibility"),
+      equilibrium_pressure_(layout, Location::Cell, 1, "equilibrium_pressure"),
+      delta_p_(layout, Location::Cell, 1, "delta_p"),
+      sum_delta_p_(layout, Location::Cell, 1, "sum_delta_p"),
+      rhs_(layout, Location::Cell, 1, "pressure_rhs"),
+      face_velocity_(layout, materials_, "face_velocity"),
+      face_specific_volume_(layout, materials_, "face_specific_volume"),
+      face_beta_(layout, 1, "face_beta"),
+      new_velocity_(layout, Location::Cell, materials_ * Dim, "new_velocity")
+{
+  if (materials_ > ice::kMaxMaterials)
+    throw InputError("cfdmpm.materials: " + std::to_string(materials_) + " materials; at most " +
+                     std::to_string(ice::kMaxMaterials) + " are allowed");
+  for (int m = 0; m < materials_; ++m) {
+    const MaterialSpec& material = scene.materials[m];
+    if (material.kind != "fluid")
+      throw InputError("cfdmpm.materials." + material.name + ".kind: got 'solid'; the fluid solver "
+                       "of this version runs fluid materials only");
+    eos_[m] = fluidEos(material);
+    viscosity_[m] = material.parameters.get<double>("viscosity");
+    names_.push_back(material.name);
+  }
+  for (int d = 0; d < 3; ++d) gravity_[d] = d < Dim ? scene.domain.gravity[d] : 0.0;
+  for (int f = 0; f < 2 * Dim; ++f) wall_no_slip_[f] = 1;
+  for (const BoundarySpec& b : scene.boundaries)
+    for (int f = 0; f < 2 * Dim; ++f)
+      if (b.face == faceName(f)) wall_no_slip_[f] = b.velocity == "no_slip";
+  pressure_solver_ = std::make_unique<PressureSolver<Dim>>(layout, settings_.linear_solver);
+  advector_ = std::make_unique<Advector<Dim>>(layout, materials_);
+}
+
+template <int Dim>
+IceSolver<Dim>::~IceSolver() = default;
+
+// [3] Equilibration pressure: per cell, the pressure at which the materials' volumes fill it.
+template <int Dim>
+int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
+{
+  const int n = materials_;
+  const auto eos = eos_;
+  auto rho = state.density.view();
+  auto T = state.temperature.view();
+  auto theta = state.volume_fraction.view();
+  auto v = state.specific_volume.view();
+  auto p = state.pressure.view();
+  auto kappa = compressibility_.view();
+  auto sum_kappa = mixture_compressibility_.view();
+  int failures = 0;
+  Kokkos::parallel_reduce(
+      "ice::equilibrate", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+      KOKKOS_LAMBDA(const LocalOrdinal c, int& failed) {
+        ice::MaterialArray<double> mass_density, temperature;
+        for (int m = 0; m < n; ++m) {
+          mass_density[m] = rho(c, m) > 0 ? rho(c, m) : 0.0;
+          temperature[m] = T(c, m);
+        }
+        const ice::EquilibrationResult r = ice::equilibrationPressure(n, eos, mass_density, temperature, p(c, 0));
+        if (!r.converged()) ++failed;
+        p(c, 0) = r.pressure;
+        double sk = 0;
+        for (int m = 0; m < n; ++m) {
+          theta(c, m) = r.volume_fraction[m];
+          v(c, m) = 1.0 / r.density[m];
+          kappa(c, m) = r.compressibility[m];
+          sk += r.volume_fraction[m] * r.compressibility[m];
+        }
+        sum_kappa(c, 0) = sk;
+      },
+      failures);
+  for (Field<Dim>* f : {&state.volume_fraction, &state.specific_volume, &state.pressure, &compressibility_,
+                        &mixture_compressibility_})
+    f->exchangeHalo();
+  int total = 0;
+  Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_SUM, failures, Teuchos::outArg(total));
+  return total;
+}
+
+// [4] Face velocities before exchange: the density-weighted average of the two cells, accelerated
+// by the pressure difference (harmonic-mean specific volume) and gravity (Kashiwa; Uintah
+// computeVel_FC). Stored on the lower face of each owned cell; domain faces stay zero (walls).
+template <int Dim>
+void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
+{
+  const int n = materials_;
+  const auto neighbours = layout_->cellNeighbours();
+  const auto rho = state.density.view();
+  const auto u = state.velocity.view();
+  const auto v = state.specific_volume.view();
+  const auto p = state.pressure.view();
+  for (int d = 0; d < Dim; ++d) {
+    auto uf = face_velocity_.direction(d).view();
+    const double h = layout_->grid().spacing()[d];
+    const double g = gravity_[d];
+    Kokkos::parallel_for(
+        "ice::faceVelocities", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+        KOKKOS_LAMBDA(const LocalOrdinal c) {
+          const LocalOrdinal l = neighbours(c, 2 * d);
+          for (int m = 0; m < n; ++m) {
+            if (l < 0) {
+              uf(c, m) = 0.0;
+              continue;
+            }
+            const double rl = rho(l, m), rr = rho(c, m);
+            const double ul = u(l, m * Dim + d), ur = u(c, m * Dim + d);
+            const double mean = (rl * ul + rr * ur) / (rl + rr + kTiny);
+            const double vbar = 2.0 * v(l, m) * v(c, m) / (v(l, m) + v(c, m));
+            uf(c, m) = mean - dt * vbar * (p(c, 0) - p(l, 0)) / h + dt * g;
+          }
+        });
+  }
+}
+
+// [4] Implicit face momentum exchange and the face specific volume the pressure equation uses.
+template <int Dim>
+void IceSolver<Dim>::faceExchange(const CellState<Dim>& state, double dt)
+{
+  const int n = materials_;
+  const auto neighbours = layout_->cellNeighbours();
+  const auto theta = state.volume_fraction.view();
+  const auto v = state.specific_volume.view();
+  const auto K = ice::ExchangeCoefficients::uniform(settings_.exchange_coefficient);
+  for (int d = 0; d < Dim; ++d) {
+    auto uf = face_velocity_.direction(d).view();
+    auto vf = face_specific_volume_.direction(d).view();
+    auto beta = face_beta_.direction(d).view();
+    Kokkos::parallel_for(
+        "ice::faceExchange", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+        KOKKOS_LAMBDA(const LocalOrdinal c) {
+          const LocalOrdinal l = neighbours(c, 2 * d);
+          if (l < 0) {
+            for (int m = 0; m < n; ++m) vf(c, m) = 0.0;
+            beta(c, 0) = 0.0;
+            return;
+          }
+          ice::MaterialArray<double> tl, tr, vl, vr, vel, sv;
+          for (int m = 0; m < n; ++m) {
+            tl[m] = theta(l, m), tr[m] = theta(c, m), vl[m] = v(l, m), vr[m] = v(c, m), vel[m] = uf(c, m);
+          }
+          ice::exchangeMomentumFC(n, dt, K, tl, tr, vl, vr, vel, sv);
+          // A material absent on both sides has no weight in the exchange and would keep its own
+          // acceleration (for air inside water, v_air ∇p ~ 800 g); it moves with the mixture instead,
+          // whose specific volume is β = Σ θ_f v_f (Σ θ_f = 1).
+          double b = 0, weight = 0, momentum = 0;
+          for (int m = 0; m < n; ++m) {
+            const double w = (tl[m] + tr[m]) / sv[m];
+            weight += w;
+            momentum += w * vel[m];
+            b += 0.5 * (tl[m] + tr[m]) * sv[m];
+          }
+          const double mixture = momentum / (weight + kTiny);
+          for (int m = 0; m < n; ++m) {
+            const bool present = tl[m] + tr[m] > 0;
+            uf(c, m) = present ? vel[m] : mixture;
+            vf(c, m) = present ? sv[m] : b;  // and follows the mixture's pressure correction
+          }
+          beta(c, 0) = b;
+        });
+  }
+  face_velocity_.exchangeHalo();
+  face_specific_volume_.exchangeHalo();
+  face_beta_.exchangeHalo();
+}
+
+// [5] Right-hand side of the pressure equation, −Δt Σ_faces A Σ_m θ_upwind,m u_f,m · n_out
+// − V κ Σδp (the outer-iteration residual form of Uintah's setupRHS); returns max |rhs| / V.
+template <int Dim>
+double IceSolver<Dim>::pressureRightHandSide(const CellState<Dim>& state, double dt)
+{
+  const int n = materials_;
+  const auto neighbours = layout_->cellNeighbours();
+  const auto theta = state.volume_fraction.view();
+  const auto sum_kappa = mixture_compressibility_.view();
+  const auto sum_dp = sum_delta_p_.view();
+  auto rhs = rhs_.view();
+  const double volume = layout_->grid().cellVolume();
+  double area[3];
+  for (int d = 0; d < Dim; ++d) area[d] = volume / layout_->grid().spacing()[d];
+  typename Field<Dim>::ConstView uf[3];
+  for (int d = 0; d < Dim; ++d) uf[d] = face_velocity_.direction(d).view();
+  double local_max = 0;
+  Kokkos::parallel_reduce(
+      "ice::pressureRhs", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+      KOKKOS_LAMBDA(const LocalOrdinal c, double& worst) {
+        double outflow = 0;  // Σ_faces A Σ_m θ_upwind u · n_out  (m^3/s)
+        for (int d = 0; d < Dim; ++d) {
+          const LocalOrdinal l = neighbours(c, 2 * d), r = neighbours(c, 2 * d + 1);
+          for (int m = 0; m < n; ++m) {
+            if (l >= 0) {  // lower face, outward normal −e_d
+              const double w = uf[d](c, m);
+              outflow -= area[d] * w * (w > 0 ? theta(l, m) : theta(c, m));
+            }
+            if (r >= 0) {  // upper face, stored on the upper neighbour
+              const double w = uf[d](r, m);
+              outflow += area[d] * w * (w > 0 ? theta(c, m) : theta(r, m));
+            }
+          }
+        }
+        rhs(c, 0) = -dt * outflow - volume * sum_kappa(c, 0) * sum_dp(c, 0);
+        const double a = Kokkos::Experimental::fabs(rhs(c, 0)) / volume;
+        if (a > worst) worst = a;
+      },
+      Kokkos::Max<double>(local_max));
+  double global_max = 0;
+  Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_MAX, local_max, Teuchos::outArg(global_max));
+  return global_max;
+}
+
+// [5] u_f −= Δt v_f (δp_R − δp_L) / h for every material.
+template <int Dim>
+void IceSolver<Dim>::correctFaceVelocities(double dt)
+{
+  const int n = materials_;
+  const auto neighbours = layout_->cellNeighbours();
+  const auto dp = delta_p_.view();
+  for (int d = 0; d < Dim; ++d) {
+    auto uf = face_velocity_.direction(d).view();
+    const auto vf = face_specific_volume_.direction(d).view();
+    const double h = layout_->grid().spacing()[d];
+    Kokkos::parallel_for(
+        "ice::correctFaceVelocities", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+        KOKKOS_LAMBDA(const LocalOrdinal c) {
+          const LocalOrdinal l = neighbours(c, 2 * d);
+          if (l < 0) return;
+          for (int m = 0; m < n; ++m) uf(c, m) -= dt * vf(c, m) * (dp(c, 0) - dp(l, 0)) / h;
+        });
+  }
+  face_velocity_.exchangeHalo();
+}
+
+// [6] + [8] Momentum sources and Lagrangian values. Face pressure p_f weighted by the summed
+// densities of the two cells (Uintah computePressFC); force on material m: −θ_m V ∇p_f, Newtonian
+// viscous stress (θ μ ∇²u per material), gravity. The Lagrangian specific volume follows the pressure
+// change: v_L = v (1 − κ_m Σδp) (Uintah computeLagrangianSpecificVolume, isothermal).
+template <int Dim>
+void IceSolver<Dim>::momentumAndLagrangianValues(CellState<Dim>& state, double dt)
+{
+  const int n = materials_;
+  const auto neighbours = layout_->cellNeighbours();
+  const auto theta = state.volume_fraction.view();
+  const auto rho = state.density.view();
+  const auto p = state.pressure.view();
+  const auto kappa = compressibility_.view();
+  const auto sum_dp = sum_delta_p_.view();
+  auto u = state.velocity.view();
+  auto v = state.specific_volume.view();
+  const auto mu = viscosity_;
+  double h[3], g[3];
+  int no_slip[6];
+  for (int d = 0; d < Dim; ++d) h[d] = layout_->grid().spacing()[d], g[d] = gravity_[d];
+  for (int f = 0; f < 2 * Dim; ++f) no_slip[f] = wall_no_slip_[f];
+  // New velocities go to a copy so that the viscous stencil reads old values only.
+  auto un = new_velocity_.view();
+  Kokkos::parallel_for(
+      "ice::momentumSources", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+      KOKKOS_LAMBDA(const LocalOrdinal c) {
+        double sum_rho_c = 0;
+        for (int m = 0; m < n; ++m) sum_rho_c += rho(c, m);
+        double grad_p[3] = {0, 0, 0};
+        for (int d = 0; d < Dim; ++d) {
+          double face_p[2];
+          for (int side = 0; side < 2; ++side) {
+            const LocalOrdinal o = neighbours(c, 2 * d + side);
+            if (o < 0) {
+              // Wall: the pressure's normal gradient is the hydrostatic one (dp/dn = ρ g·n), so a
+              // fluid at rest next to a wall feels no net force.
+              face_p[side] = p(c, 0) + (side == 0 ? -0.5 : 0.5) * h[d] * sum_rho_c * g[d];
+              continue;
+            }
+            double sum_rho_o = 0;
+            for (int m = 0; m < n; ++m) sum_rho_o += rho(o, m);
+            face_p[side] = (p(o, 0) * sum_rho_c + p(c, 0) * sum_rho_o) / (sum_rho_c + sum_rho_o + kTiny);
+          }
+          grad_p[d] = (face_p[1] - face_p[0]) / h[d];
+        }
+        for (int m = 0; m < n; ++m) {
+          const double r = rho(c, m);
+          for (int k = 0; k < Dim; ++k) {
+            // Viscous force per volume: θ_m μ_m ∇²u_k, so that the acceleration is ν_m ∇²u_k whatever
+            // the material's share of the cell (a face-averaged θ would blow up where θ_c -> 0).
+            double viscous = 0;
+            for (int d = 0; d < Dim; ++d)
+              for (int side = 0; side < 2; ++side) {
+                const int f = 2 * d + side;
+                const LocalOrdinal o = neighbours(c, f);
+                if (o >= 0) {
+                  viscous += mu[m] * theta(c, m) * (u(o, m * Dim + k) - u(c, m * Dim + k)) / (h[d] * h[d]);
+                } else if (no_slip[f] && k != d) {
+                  viscous -= mu[m] * theta(c, m) * 2.0 * u(c, m * Dim + k) / (h[d] * h[d]);
+                }
+              }
+            const double force = -theta(c, m) * grad_p[k] + viscous + r * g[k];  // per volume
+            un(c, m * Dim + k) = r > 0 ? u(c, m * Dim + k) + dt * force / r : u(c, m * Dim + k);
+          }
+          v(c, m) = v(c, m) * (1.0 - kappa(c, m) * sum_dp(c, 0));
+        }
+      });
+  Kokkos::parallel_for(
+      "ice::copyVelocity", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+      KOKKOS_LAMBDA(const LocalOrdinal c) {
+        for (int k = 0; k < n * Dim; ++k) u(c, k) = un(c, k);
+      });
+}
+
+// [8] Implicit cell-centred momentum exchange (Uintah addExch_Vel_Temp_CC, momentum part).
+template <int Dim>
+void IceSolver<Dim>::cellExchange(CellState<Dim>& state, double dt)
+{
+  const int n = materials_;
+  const auto theta = state.volume_fraction.view();
+  const auto rho = state.density.view();
+  const auto v = state.specific_volume.view();
+  auto u = state.velocity.view();
+  const auto K = ice::ExchangeCoefficients::uniform(settings_.exchange_coefficient);
+  Kokkos::parallel_for(
+      "ice::cellExchange", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+      KOKKOS_LAMBDA(const LocalOrdinal c) {
+        ice::MaterialArray<double> r, t, s;
+        ice::MaterialArray<Kokkos::Array<double, Dim>> vel;
+        for (int m = 0; m < n; ++m) {
+          r[m] = rho(c, m), t[m] = theta(c, m), s[m] = v(c, m);
+          for (int d = 0; d < Dim; ++d) vel[m][d] = u(c, m * Dim + d);
+        }
+        ice::exchangeMomentumCC<Dim>(n, dt, K, r, t, s, vel);
+        // A material without mass in the cell takes the mixture's velocity, so that its (meaningless)
+        // own value can neither limit the time step nor leak into advection when it arrives.
+        double mass = 0, momentum[3] = {0, 0, 0};
+        for (int m = 0; m < n; ++m) {
+          mass += r[m];
+          for (int d = 0; d < Dim; ++d) momentum[d] += r[m] * vel[m][d];
+        }
+        for (int m = 0; m < n; ++m)
+          for (int d = 0; d < Dim; ++d)
+            u(c, m * Dim + d) = r[m] > kNegligibleMassShare * mass ? vel[m][d] : momentum[d] / (mass + kTiny);
+      });
+}
+
+template <int Dim>
+IceStepReport IceSolver<Dim>::step(CellState<Dim>& state, double dt)
+{
+  IceStepReport report;
+  // [3] Equilibration pressure, volume fractions, specific volumes, compressibilities.
+  report.equilibration_failures = equilibrate(state);
+  Kokkos::deep_copy(equilibrium_pressure_.view(), state.pressure.view());
+
+  // [4] Face velocities and face exchange.
+  state.velocity.exchangeHalo();
+  state.density.exchangeHalo();
+  faceVelocities(state, dt);
+  faceExchange(state, dt);
+
+  // [5] Pressure correction with outer iterations (implicit), or one explicit update.
+  sum_delta_p_.fill(0.0);
+  delta_p_.fill(0.0);
+  const bool implicit = settings_.pressure == "implicit";
+  if (implicit) pressure_solver_->assemble(mixture_compressibility_, face_beta_, dt);
+  double residual = pressureRightHandSide(state, dt);
+  while (residual > settings_.outer_tolerance && report.outer_iterations < settings_.max_outer_iterations) {
+    ++report.outer_iterations;
+    if (implicit) {
+      delta_p_.fill(0.0);
+      const PressureSolveReport solve = pressure_solver_->solve(rhs_, delta_p_);
+      report.linear_iterations += solve.iterations;
+      if (!solve.converged)
+        throw std::runtime_error("ice: pressure solve did not converge (relative residual " +
+                                 std::to_string(solve.relative_residual) + " after " +
+                                 std::to_string(solve.iterations) + " iterations)");
+    } else {
+      // Explicit: δp = rhs / (V κ), faces not coupled through the pressure Laplacian.
+      const auto rhs = rhs_.view();
+      const auto sk = mixture_compressibility_.view();
+      auto dp = delta_p_.view();
+      const double volume = layout_->grid().cellVolume();
+      Kokkos::parallel_for(
+          "ice::explicitPressure", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+          KOKKOS_LAMBDA(const LocalOrdinal c) { dp(c, 0) = rhs(c, 0) / (volume * sk(c, 0)); });
+      delta_p_.exchangeHalo();
+    }
+    // p = p_eq + Σδp; faces corrected with this iteration's δp.
+    {
+      auto sum = sum_delta_p_.view();
+      const auto dp = delta_p_.view();
+      auto p = state.pressure.view();
+      const auto p_eq = equilibrium_pressure_.view();
+      Kokkos::parallel_for(
+          "ice::updatePressure", Kokkos::RangePolicy<ExecutionSpace>(0, delta_p_.overlapCount()),
+          KOKKOS_LAMBDA(const LocalOrdinal c) {
+            sum(c, 0) += dp(c, 0);
+            p(c, 0) = p_eq(c, 0) + sum(c, 0);
+          });
+    }
+    if (!implicit) {
+      // The explicit scheme does not correct face velocities: one pass.
+      residual = 0;
+      break;
+    }
+    correctFaceVelocities(dt);
+    residual = pressureRightHandSide(state, dt);
+  }
+  report.outer_residual = residual;
+  report.converged = residual <= settings_.outer_tolerance || !implicit;
+
+  // [6] + [8] Momentum sources, Lagrangian values, cell-centred exchange.
+  state.pressure.exchangeHalo();
+  momentumAndLagrangianValues(state, dt);
+  cellExchange(state, dt);
+
+  // [10] Advection of mass, velocity and specific volume by the corrected face velocities.
+  const AdvectionStatus advected =
+      advector_->advect(face_velocity_, dt, state.density, {&state.velocity, &state.specific_volume});
+  report.max_outflux_fraction = advected.max_outflux_fraction;
+  if (!advected.ok) throw std::runtime_error("ice: " + advected.message());
+
+  // Closure: θ = ρ v (the next equilibration restores Σθ = 1); a material without mass in a cell
+  // takes the mixture's velocity there (advection leaves its own value undefined).
+  {
+    auto theta = state.volume_fraction.view();
+    auto u = state.velocity.view();
+    const auto rho = state.density.view();
+    const auto v = state.specific_volume.view();
+    const int n = materials_;
+    Kokkos::parallel_for(
+        "ice::closeCells", Kokkos::RangePolicy<ExecutionSpace>(0, state.density.overlapCount()),
+        KOKKOS_LAMBDA(const LocalOrdinal c) {
+          double mass = 0, momentum[3] = {0, 0, 0};
+          for (int m = 0; m < n; ++m) {
+            theta(c, m) = rho(c, m) * v(c, m);
+            mass += rho(c, m);
+            for (int d = 0; d < Dim; ++d) momentum[d] += rho(c, m) * u(c, m * Dim + d);
+          }
+          for (int m = 0; m < n; ++m)
+            if (!(rho(c, m) > kNegligibleMassShare * mass))
+              for (int d = 0; d < Dim; ++d) u(c, m * Dim + d) = momentum[d] / (mass + kTiny);
+        });
+  }
+  return report;
+}
+
+template <int Dim>
+TimeStepLimit IceSolver<Dim>::stableTimeStep(const CellState<Dim>& state, double previous_dt) const
+{
+  // [11] Convective CFL: Δt ≤ CFL h / |u| per direction; viscous: Δt ≤ CFL h² / (2 Dim ν); both per
+  // material, over cells where the material is present (θ > 1e-6).
+  const int n = materials_;
+  const auto u = state.velocity.view();
+  const auto theta = state.volume_fraction.view();
+  const auto v = state.specific_volume.view();
+  double h_min = DBL_MAX, inv_h[3];
+  for (int d = 0; d < Dim; ++d) {
+    h_min = std::min(h_min, layout_->grid().spacing()[d]);
+    inv_h[d] = 1.0 / layout_->grid().spacing()[d];
+  }
+  const double cfl = scene_.time.cfl;
+  std::vector<double> local(2 * n, DBL_MAX), global(2 * n);
+  for (int m = 0; m < n; ++m) {
+    double rate = 0, max_nu = 0;
+    Kokkos::parallel_reduce(
+        "ice::stableTimeStep", Kokkos::RangePolicy<ExecutionSpace>(0, state.velocity.ownedCount()),
+        KOKKOS_LAMBDA(const LocalOrdinal c, double& worst) {
+          if (theta(c, m) < 1e-6) return;
+          double s = 0;
+          for (int d = 0; d < Dim; ++d) s = Kokkos::Experimental::fmax(s, Kokkos::Experimental::fabs(u(c, m * Dim + d)) * inv_h[d]);
+          if (s > worst) worst = s;
+        },
+        Kokkos::Max<double>(rate));
+    Kokkos::parallel_reduce(
+        "ice::viscousLimit", Kokkos::RangePolicy<ExecutionSpace>(0, state.velocity.ownedCount()),
+        KOKKOS_LAMBDA(const LocalOrdinal c, double& worst) {
+          if (theta(c, m) < 1e-6) return;
+          if (v(c, m) > worst) worst = v(c, m);
+        },
+        Kokkos::Max<double>(max_nu));
+    local[2 * m] = rate > 0 ? cfl / rate : DBL_MAX;
+    const double nu = viscosity_[m] * max_nu;  // largest kinematic viscosity μ v
+    local[2 * m + 1] = nu > 0 ? cfl * h_min * h_min / (2.0 * Dim * nu) : DBL_MAX;
+  }
+  Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_MIN, 2 * n, local.data(), global.data());
+  TimeStepLimit limit{scene_.time.dt_max, "dt_max"};
+  for (int m = 0; m < n; ++m) {
+    if (global[2 * m] < limit.dt) limit = {global[2 * m], "convection(" + names_[m] + ")"};
+    if (global[2 * m + 1] < limit.dt) limit = {global[2 * m + 1], "viscosity(" + names_[m] + ")"};
+  }
+  if (previous_dt > 0 && settings_.dt_growth * previous_dt < limit.dt)
+    limit = {settings_.dt_growth * previous_dt, "growth"};
+  if (limit.dt < scene_.time.dt_min) limit = {scene_.time.dt_min, limit.limiter + ",dt_min"};
+  return limit;
+}
+
+template class IceSolver<2>;
+template class IceSolver<3>;
+
+}  // namespace cfdmpm

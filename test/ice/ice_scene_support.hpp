@@ -1,0 +1,87 @@
+#pragma once
+// Helpers for tests that run the ICE solver on small scenes written inline as YAML.
+#include "grid/decomposition.hpp"
+#include "ice/ice_solver.hpp"
+#include "ice/material_eos.hpp"
+#include "input/scene.hpp"
+#include "mpmice/initial_state.hpp"
+
+#include <Teuchos_DefaultComm.hpp>
+
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <unistd.h>
+
+namespace cfdmpm::test {
+
+/// Reads a scene from YAML text (through a temporary file, as a user's file would be read).
+inline Scene sceneFromYaml(const std::string& text)
+{
+  char path[] = "/tmp/cfdmpm-scene-XXXXXX.yaml";
+  const int fd = mkstemps(path, 5);
+  if (fd < 0) throw std::runtime_error("cannot create a temporary scene file");
+  close(fd);
+  {
+    std::ofstream out(path);
+    out << text;
+  }
+  Scene scene = readScene(path);
+  std::remove(path);
+  return scene;
+}
+
+/// A scene's state and solver on a communicator.
+template <int Dim>
+struct IceRun {
+  IceRun(const Scene& s, const Teuchos::RCP<const Teuchos::Comm<int>>& comm)
+      : scene(s),
+        layout(std::make_shared<const Layout<Dim>>(Grid<Dim>(s.domain), partitionPatches(Grid<Dim>(s.domain), comm->getSize()),
+                                                   s.domain.ghost_width, comm)),
+        state(layout, int(s.materials.size())),
+        solver(s, layout)
+  {
+    setInitialState(scene, densityFunctions(scene), state);
+    solver.equilibrate(state);
+  }
+
+  /// Steps with the solver's own Δt (or a fixed one when fixed_dt > 0) until end_time.
+  void runUntil(double end_time, double fixed_dt = 0)
+  {
+    while (time < end_time * (1 - 1e-12)) {
+      double dt = fixed_dt > 0 ? fixed_dt
+                               : (steps == 0 ? scene.time.dt_initial : solver.stableTimeStep(state, dt_previous).dt);
+      dt_previous = dt;
+      dt = std::min(dt, end_time - time);
+      last = solver.step(state, dt);
+      time += dt;
+      ++steps;
+    }
+  }
+
+  Scene scene;
+  std::shared_ptr<const Layout<Dim>> layout;
+  CellState<Dim> state;
+  IceSolver<Dim> solver;
+  IceStepReport last;
+  double time = 0, dt_previous = 0;
+  long long steps = 0;
+};
+
+/// Sum over ranks.
+inline double globalSum(const Teuchos::Comm<int>& comm, double local)
+{
+  double total = 0;
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_SUM, local, Teuchos::outArg(total));
+  return total;
+}
+
+inline double globalMax(const Teuchos::Comm<int>& comm, double local)
+{
+  double total = 0;
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_MAX, local, Teuchos::outArg(total));
+  return total;
+}
+
+}  // namespace cfdmpm::test

@@ -95,6 +95,7 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
 
   // 3. Output: the directory (refused if it holds an earlier run, unless overwrite), the fields of
   //    step 0, and the diagnostics time series.
+  StateOutput<Dim>::checkFields(scene);
   prepareOutputDirectory(mpi, scene.output.directory, options.overwrite || scene.output.overwrite);
   const std::string run_name = std::filesystem::path(scene.path).stem().string();
   StateOutput<Dim> output(scene, *layout, run_name);

@@ -31,6 +31,17 @@ OutputLayout outputLayout(const Grid<Dim>& grid, Location location, const std::v
 }  // namespace
 
 template <int Dim>
+void StateOutput<Dim>::checkFields(const Scene& scene)
+{
+  static const std::vector<std::string> written{"volume_fraction", "density", "velocity", "temperature",
+                                                "pressure", "specific_volume"};
+  for (const std::string& f : scene.output.fields)
+    if (std::find(written.begin(), written.end(), f) == written.end())
+      throw InputError("cfdmpm.output.fields: got '" + f + "'; this version writes volume_fraction, density, "
+                       "velocity, temperature, pressure, specific_volume");
+}
+
+template <int Dim>
 StateOutput<Dim>::StateOutput(const Scene& scene, const Layout<Dim>& layout, const std::string& run_name)
     : fields_(scene.output.fields), directory_(scene.output.directory)
 {

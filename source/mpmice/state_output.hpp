@@ -15,6 +15,10 @@ namespace cfdmpm {
 template <int Dim>
 class StateOutput {
  public:
+  /// Throws InputError if output.fields asks for a field this version does not write; call it
+  /// before anything is written.
+  static void checkFields(const Scene& scene);
+
   /// The output directory must have been prepared (prepareOutputDirectory).
   StateOutput(const Scene& scene, const Layout<Dim>& layout, const std::string& run_name);
 

@@ -134,7 +134,7 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
   Kokkos::parallel_reduce(
       "ice::equilibrate", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
       KOKKOS_LAMBDA(const LocalOrdinal c, int& failed) {
-        ice::MaterialArray<double> mass_density, temperature;
+        ice::MaterialArray<double> mass_density{}, temperature{};
         for (int m = 0; m < n; ++m) {
           mass_density[m] = rho(c, m) > 0 ? rho(c, m) : 0.0;
           temperature[m] = T(c, m);
@@ -217,7 +217,7 @@ void IceSolver<Dim>::faceExchange(const CellState<Dim>& state, double dt)
             beta(c, 0) = 0.0;
             return;
           }
-          ice::MaterialArray<double> tl, tr, vl, vr, vel, sv;
+          ice::MaterialArray<double> tl{}, tr{}, vl{}, vr{}, vel{}, sv{};
           for (int m = 0; m < n; ++m) {
             tl[m] = theta(l, m), tr[m] = theta(c, m), vl[m] = v(l, m), vr[m] = v(c, m), vel[m] = uf(c, m);
           }
@@ -399,8 +399,8 @@ void IceSolver<Dim>::cellExchange(CellState<Dim>& state, double dt)
   Kokkos::parallel_for(
       "ice::cellExchange", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
       KOKKOS_LAMBDA(const LocalOrdinal c) {
-        ice::MaterialArray<double> r, t, s;
-        ice::MaterialArray<Kokkos::Array<double, Dim>> vel;
+        ice::MaterialArray<double> r{}, t{}, s{};
+        ice::MaterialArray<Kokkos::Array<double, Dim>> vel{};
         for (int m = 0; m < n; ++m) {
           r[m] = rho(c, m), t[m] = theta(c, m), s[m] = v(c, m);
           for (int d = 0; d < Dim; ++d) vel[m][d] = u(c, m * Dim + d);

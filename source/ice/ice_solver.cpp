@@ -19,6 +19,9 @@ constexpr double kTiny = 1e-100;  // guards divisions by a vanishing mass or den
 // A material holding less than this share of a cell's mass has no velocity of its own: it moves
 // with the mixture (its own momentum equation would divide by a vanishing mass).
 constexpr double kNegligibleMassShare = 1e-12;
+// Likewise on a face: a material filling less than this share of both neighbours has no face
+// velocity of its own (a denormal volume fraction would leave it uncoupled by the exchange).
+constexpr double kNegligibleVolumeShare = 1e-12;
 
 template <class T>
 T getOr(const Teuchos::ParameterList& list, const std::string& key, T fallback)
@@ -234,7 +237,7 @@ void IceSolver<Dim>::faceExchange(const CellState<Dim>& state, double dt)
           }
           const double mixture = momentum / (weight + kTiny);
           for (int m = 0; m < n; ++m) {
-            const bool present = tl[m] + tr[m] > 0;
+            const bool present = tl[m] + tr[m] > 2 * kNegligibleVolumeShare;
             uf(c, m) = present ? vel[m] : mixture;
             vf(c, m) = present ? sv[m] : b;  // and follows the mixture's pressure correction
           }

@@ -1,11 +1,14 @@
 #!/usr/bin/env bash
-# Runs the default dam-break scene on N ranks into a temporary directory and checks its initial
-# state with check_initial_state.py. A second run without --overwrite must be refused.
+# Runs the default dam-break scene on N ranks into a temporary directory, stopped before its first
+# step (time.max_steps: 0), and checks its initial state with check_initial_state.py. A second run
+# without --overwrite must be refused.
 set -eu
 ranks=$1
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-sed "s|directory: .*|directory: $work/out|" "$SOURCE_DIR/input/dam-break.yaml" > "$work/dam-break.yaml"
+sed -e "s|directory: .*|directory: $work/out|" -e "s|    end_time: 0.25|    end_time: 0.25\n    max_steps: 0|" \
+    "$SOURCE_DIR/input/dam-break.yaml" > "$work/dam-break.yaml"
+grep -q "max_steps: 0" "$work/dam-break.yaml"
 grep -q "directory: $work/out" "$work/dam-break.yaml"
 "$MPIEXEC" -n "$ranks" "$CFDMPM" "$work/dam-break.yaml"
 "$PYTHON" "$SOURCE_DIR/test/app/check_initial_state.py" "$work/out" "$work/dam-break.yaml"

@@ -1,0 +1,659 @@
+#include "mpm/mpm_solver.hpp"
+
+#include "mpm/shape_functions.hpp"
+
+#include <Teuchos_CommHelpers.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace cfdmpm::mpm {
+
+namespace {
+
+/// Kernels keep per-material values on the stack; a scene has a handful of solids.
+constexpr int kMaxMaterials = 8;
+
+/// Below this fraction of its material's particle mass a node counts as empty (v = 0): GIMP
+/// weights near the edge of a particle's support are arbitrarily small.
+constexpr double kEmptyNodeMassFraction = 1e-12;
+
+/// Columns of the node sums: mass, momentum, force and (for contact) mass gradient per material.
+struct NodeColumns {
+  int materials = 1;
+  int dim = 2;
+  KOKKOS_INLINE_FUNCTION int mass(int m) const { return m; }
+  KOKKOS_INLINE_FUNCTION int momentum(int m, int d) const { return materials + m * dim + d; }
+  KOKKOS_INLINE_FUNCTION int force(int m, int d) const { return materials * (1 + dim) + m * dim + d; }
+  KOKKOS_INLINE_FUNCTION int massGradient(int m, int d) const { return materials * (1 + 2 * dim) + m * dim + d; }
+  int count(bool with_gradients) const { return materials * (1 + (with_gradients ? 3 : 2) * dim); }
+};
+
+/// What the grid kernels need to know of the materials, by value.
+struct MaterialTable {
+  int count = 0;
+  int rigid[kMaxMaterials] = {};
+  double rigid_velocity[kMaxMaterials][3] = {};
+};
+
+MaterialTable materialTable(const std::vector<SolidMaterial>& materials)
+{
+  MaterialTable table;
+  table.count = int(materials.size());
+  for (int m = 0; m < table.count; ++m)
+    if (const Rigid* rigid = materials[m].model.getIf<Rigid>()) {
+      table.rigid[m] = 1;
+      for (int d = 0; d < 3; ++d) table.rigid_velocity[m][d] = rigid->velocity(d);
+    }
+  return table;
+}
+
+/// Coulomb friction with free separation (Bardenhagen et al. 2001, eqs. 8-10): a body whose
+/// velocity v, relative to a reference velocity v_ref, moves along the outward normal n loses that
+/// normal part, and its tangential part shrinks by at most mu times the normal part (sticks when
+/// friction suffices). Moving apart (normal part <= 0) it is left free. Used between materials
+/// (v_ref the centre-of-mass velocity) and against walls (v_ref = 0).
+template <int Dim>
+KOKKOS_INLINE_FUNCTION void frictionalContact(double v[Dim], const double v_ref[Dim], const double n[Dim], double mu)
+{
+  double dv[Dim], normal = 0.0;
+  for (int d = 0; d < Dim; ++d) {
+    dv[d] = v[d] - v_ref[d];
+    normal += dv[d] * n[d];
+  }
+  if (!(normal > 0.0)) return;
+  double tangent[Dim], tangent_norm2 = 0.0;
+  for (int d = 0; d < Dim; ++d) {
+    tangent[d] = dv[d] - normal * n[d];
+    tangent_norm2 += tangent[d] * tangent[d];
+  }
+  const double tangent_norm = math::sqrt(tangent_norm2);
+  // Tangential reduction min(mu dv_n, |dv_t|): sticking when the friction cone holds it.
+  const double scale = tangent_norm > 0.0 ? math::min(mu * normal, tangent_norm) / tangent_norm : 0.0;
+  for (int d = 0; d < Dim; ++d) v[d] -= normal * n[d] + scale * tangent[d];
+}
+
+MPI_Comm rawComm(const Teuchos::RCP<const Teuchos::Comm<int>>& comm)
+{
+  return *Teuchos::rcp_dynamic_cast<const Teuchos::MpiComm<int>>(comm, true)->getRawMpiComm();
+}
+
+}  // namespace
+
+template <int Dim>
+MpmSolver<Dim>::MpmSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>> layout, const MpmOptions& options)
+    : layout_(std::move(layout)), options_(options), materials_(solidMaterials(scene))
+{
+  if (scene.domain.dimension != Dim)
+    throw std::invalid_argument("MpmSolver<" + std::to_string(Dim) + ">: the scene is " +
+                                std::to_string(scene.domain.dimension) + "-D");
+  if (layout_->ghostWidth() < 1) throw std::invalid_argument("MpmSolver: the layout needs ghost_width >= 1");
+  if (int(materials_.size()) > kMaxMaterials)
+    throw InputError("cfdmpm.materials: " + std::to_string(materials_.size()) + " solid materials; MPM handles at most " +
+                     std::to_string(kMaxMaterials));
+  if (!(options_.flip_fraction >= 0.0 && options_.flip_fraction <= 1.0))
+    throw std::invalid_argument("MpmOptions::flip_fraction must lie in [0, 1], got " + std::to_string(options_.flip_fraction));
+  if (!(options_.wall_friction >= 0.0) || !(options_.contact_friction >= 0.0))
+    throw std::invalid_argument("MpmOptions: friction coefficients must be >= 0");
+  if (!(options_.velocity_damping >= 0.0)) throw std::invalid_argument("MpmOptions::velocity_damping must be >= 0");
+  cfl_ = options_.cfl > 0.0 ? options_.cfl : scene.time.cfl;
+  gravity_ = scene.domain.gravity;
+
+  for (int f = 0; f < 2 * Dim; ++f) wall_no_slip_[f] = 1;  // a face not given is a no-slip wall
+  for (const BoundarySpec& b : scene.boundaries)
+    for (int f = 0; f < 2 * Dim; ++f)
+      if (b.face == faceName(f)) wall_no_slip_[f] = b.velocity == "free_slip" ? 0 : 1;
+
+  double smallest_particle = std::numeric_limits<double>::max();
+  for (const SolidMaterial& s : materials_)
+    smallest_particle = std::min(smallest_particle, s.density * layout_->grid().cellVolume() /
+                                                        std::pow(double(s.particles_per_cell), Dim));
+  empty_node_mass_ = kEmptyNodeMassFraction * smallest_particle;
+
+  particles_ = seedParticles(scene, *layout_, materials_);
+  allocateNodeFields();
+  migration_ = std::make_unique<ParticleMigration<Dim>>(*layout_);
+}
+
+template <int Dim>
+void MpmSolver<Dim>::allocateNodeFields()
+{
+  const int nm = std::max(1, int(materials_.size()));
+  const NodeColumns columns{nm, Dim};
+  const bool gradients = options_.contact && materials_.size() > 1;
+  node_sums_ = std::make_unique<Field<Dim>>(layout_, Location::Node, columns.count(gradients), "mpm node sums");
+  node_velocity_ = std::make_unique<Field<Dim>>(layout_, Location::Node, nm * Dim, "mpm node velocity");
+  node_velocity_star_ = std::make_unique<Field<Dim>>(layout_, Location::Node, nm * Dim, "mpm node velocity star");
+}
+
+template <int Dim>
+void MpmSolver<Dim>::repartition(std::shared_ptr<const Layout<Dim>> layout)
+{
+  layout_ = std::move(layout);
+  allocateNodeFields();
+  migration_ = std::make_unique<ParticleMigration<Dim>>(*layout_);
+  relocateParticles();
+}
+
+template <int Dim>
+void MpmSolver<Dim>::setGravity(const std::array<double, 3>& gravity)
+{
+  gravity_ = gravity;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The step
+// ---------------------------------------------------------------------------------------------
+
+template <int Dim>
+void MpmSolver<Dim>::step(double dt)
+{
+  particlesToGrid();
+  integrateGrid(dt);
+  gridToParticles(dt);
+  updateStress(dt);
+  relocateParticles();
+}
+
+template <int Dim>
+void MpmSolver<Dim>::particlesToGrid()
+{
+  if (options_.shape_function == ShapeFunction::Gimp)
+    particlesToGridWith<UniformGimp>();
+  else
+    particlesToGridWith<LinearHat>();
+}
+
+template <int Dim>
+void MpmSolver<Dim>::gridToParticles(double dt)
+{
+  if (options_.shape_function == ShapeFunction::Gimp)
+    gridToParticlesWith<UniformGimp>(dt);
+  else
+    gridToParticlesWith<LinearHat>(dt);
+}
+
+/// P2G: m_i = sum_p w_ip m_p, (mv)_i = sum_p w_ip m_p v_p,
+///      f_i = sum_p (-V_p sigma_p grad w_ip + w_ip m_p g)   (internal + external force),
+///      grad m_i = sum_p m_p grad w_ip                       (material normals for contact),
+/// per material, scattered with atomics (race-free on threads), then summed across ranks.
+template <int Dim>
+template <class Kernel>
+void MpmSolver<Dim>::particlesToGridWith()
+{
+  node_sums_->fill(0.0);
+  const Grid<Dim>& grid = layout_->grid();
+  const NodeColumns col{std::max(1, int(materials_.size())), Dim};
+  const bool gradients = options_.contact && materials_.size() > 1;
+  const auto x = particles_.position;
+  const auto v = particles_.velocity;
+  const auto mass = particles_.mass;
+  const auto volume = particles_.volume;
+  const auto sigma = particles_.stress;
+  const auto half_width = particles_.half_width;
+  const auto material = particles_.material;
+  const BoxLookup lookup = layout_->nodeLookup();
+  double origin[Dim], spacing[Dim], g[Dim];
+  long long nodes[Dim];
+  for (int d = 0; d < Dim; ++d) {
+    origin[d] = grid.lower()[d], spacing[d] = grid.spacing()[d], g[d] = gravity_[d];
+    nodes[d] = grid.nodes()[d];
+  }
+  Kokkos::View<int, MemorySpace> missing("nodes missing from the overlap");
+  {
+    auto sums = node_sums_->view();
+    Kokkos::parallel_for(
+        "mpm::particles_to_grid", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count), KOKKOS_LAMBDA(const int p) {
+          double xp[Dim], lp[Dim];
+          for (int d = 0; d < Dim; ++d) xp[d] = x(p, d), lp[d] = half_width(p, d);
+          ShapeStencil<Dim, Kernel> s;
+          evaluateShape(xp, origin, spacing, lp, s);
+          const int m = material(p);
+          const double mp = mass(p), Vp = volume(p);
+          for (int k = 0; k < s.size; ++k) {
+            long long node[3] = {0, 0, 0};
+            s.node(k, node);
+            const LocalOrdinal lid = lookup(node[0], node[1], node[2]);
+            if (lid < 0) {
+              bool inside = true;
+              for (int d = 0; d < Dim; ++d) inside = inside && node[d] >= 0 && node[d] < nodes[d];
+              if (inside && s.weight[k] > 0.0) Kokkos::atomic_add(&missing(), 1);
+              continue;  // outside the grid: the part of the particle beyond the wall
+            }
+            const double w = s.weight[k];
+            Kokkos::atomic_add(&sums(lid, col.mass(m)), w * mp);
+            for (int d = 0; d < Dim; ++d) {
+              double internal = 0.0;
+              for (int e = 0; e < Dim; ++e) internal -= sigma(p, d, e) * s.gradient[k][e];
+              Kokkos::atomic_add(&sums(lid, col.momentum(m, d)), w * mp * v(p, d));
+              Kokkos::atomic_add(&sums(lid, col.force(m, d)), Vp * internal + w * mp * g[d]);
+              // grad m(x_i) = sum_p m_p dS(x_i - x_p)/dx_i = -sum_p m_p dw_ip/dx_p
+              if (gradients) Kokkos::atomic_add(&sums(lid, col.massGradient(m, d)), -mp * s.gradient[k][d]);
+            }
+          }
+        });
+  }
+  int missing_host = 0;
+  Kokkos::deep_copy(missing_host, missing);
+  if (missing_host > 0 && pending_error_.empty())  // raised on every rank by relocateParticles
+    pending_error_ = "MPM particles-to-grid: " + std::to_string(missing_host) +
+                     " particle-node pairs reach nodes beyond rank " + std::to_string(layout_->comm()->getRank()) +
+                     "'s ghost nodes; particles must lie in owned cells (relocateParticles) and ghost_width must "
+                     "be >= 1";
+  node_sums_->sumToOwners();
+}
+
+/// Grid update on every local node (the node sums are complete on ghosts too):
+///   v_i = (mv)_i / m_i,   v*_i = v_i + dt (f_i / m_i - alpha v_i),
+/// rigid materials take their prescribed velocity; then contact between materials on v*
+/// (Bardenhagen et al. 2001), then the walls on v* (no_slip: v* = 0; free_slip: Coulomb friction
+/// with free separation, coefficient MpmOptions::wall_friction).
+template <int Dim>
+void MpmSolver<Dim>::integrateGrid(double dt)
+{
+  const Grid<Dim>& grid = layout_->grid();
+  const int nm = int(materials_.size());
+  const NodeColumns col{std::max(1, nm), Dim};
+  const bool contact = options_.contact && nm > 1;
+  const MaterialTable table = materialTable(materials_);
+  const double empty = empty_node_mass_;
+  const double alpha = options_.velocity_damping;
+  const double mu_contact = options_.contact_friction;
+  const double mu_wall = options_.wall_friction;
+  const auto ijk = layout_->nodeIndex();
+  int no_slip[2 * Dim];
+  long long last_node[Dim];
+  for (int f = 0; f < 2 * Dim; ++f) no_slip[f] = wall_no_slip_[f];
+  for (int d = 0; d < Dim; ++d) last_node[d] = grid.nodes()[d] - 1;
+  const auto sums = node_sums_->view();
+  auto velocity = node_velocity_->view();
+  auto velocity_star = node_velocity_star_->view();
+
+  Kokkos::parallel_for(
+      "mpm::integrate_grid", Kokkos::RangePolicy<ExecutionSpace>(0, node_sums_->overlapCount()),
+      KOKKOS_LAMBDA(const int i) {
+        double v[kMaxMaterials][Dim], vs[kMaxMaterials][Dim], m[kMaxMaterials];
+        int occupied = 0, rigid = -1;
+        for (int a = 0; a < nm; ++a) {
+          m[a] = sums(i, col.mass(a));
+          const bool has_mass = m[a] > empty;
+          if (has_mass) ++occupied;
+          if (has_mass && table.rigid[a] && rigid < 0) rigid = a;
+          for (int d = 0; d < Dim; ++d) {
+            if (!has_mass) {
+              v[a][d] = vs[a][d] = 0.0;
+            } else if (table.rigid[a]) {
+              v[a][d] = vs[a][d] = table.rigid_velocity[a][d];
+            } else {
+              v[a][d] = sums(i, col.momentum(a, d)) / m[a];
+              vs[a][d] = v[a][d] + dt * (sums(i, col.force(a, d)) / m[a] - alpha * v[a][d]);
+            }
+          }
+        }
+
+        // Contact where two or more materials meet: each approaching material loses its normal
+        // velocity relative to the centre of mass (a rigid material's velocity when one is there).
+        // Only v* is corrected: the FLIP increment v* - v then carries the contact impulse to the
+        // particles, as it carries the walls' (a corrected v would let FLIP particles keep their
+        // approach velocity).
+        if (contact && occupied > 1) {
+          double cm_star[Dim];
+          for (int d = 0; d < Dim; ++d) {
+            if (rigid >= 0) {
+              cm_star[d] = table.rigid_velocity[rigid][d];
+            } else {
+              double ps = 0.0, total = 0.0;
+              for (int a = 0; a < nm; ++a)
+                if (m[a] > empty) ps += m[a] * vs[a][d], total += m[a];
+              cm_star[d] = ps / total;
+            }
+          }
+          for (int a = 0; a < nm; ++a) {
+            if (!(m[a] > empty) || table.rigid[a]) continue;
+            double n[Dim], norm2 = 0.0;
+            for (int d = 0; d < Dim; ++d) {
+              n[d] = -sums(i, col.massGradient(a, d));  // outward: mass decreases outwards
+              norm2 += n[d] * n[d];
+            }
+            if (!(norm2 > 0.0)) continue;
+            const double inv = 1.0 / math::sqrt(norm2);
+            for (int d = 0; d < Dim; ++d) n[d] *= inv;
+            frictionalContact<Dim>(vs[a], cm_star, n, mu_contact);
+          }
+        }
+
+        // Walls: nodes on a domain face.
+        for (int d = 0; d < Dim; ++d) {
+          for (int side = 0; side < 2; ++side) {
+            if (ijk(i, d) != (side == 0 ? 0 : last_node[d])) continue;
+            const int face = 2 * d + side;
+            double n[Dim], zero[Dim];
+            for (int e = 0; e < Dim; ++e) n[e] = 0.0, zero[e] = 0.0;
+            n[d] = side == 0 ? -1.0 : 1.0;  // outward normal of the domain
+            for (int a = 0; a < nm; ++a) {
+              if (table.rigid[a]) continue;
+              if (no_slip[face]) {
+                for (int e = 0; e < Dim; ++e) vs[a][e] = 0.0;
+              } else {
+                frictionalContact<Dim>(vs[a], zero, n, mu_wall);
+              }
+            }
+          }
+        }
+
+        for (int a = 0; a < nm; ++a)
+          for (int d = 0; d < Dim; ++d) {
+            velocity(i, a * Dim + d) = v[a][d];
+            velocity_star(i, a * Dim + d) = vs[a][d];
+          }
+      });
+}
+
+/// G2P: v_p <- f (v_p + sum_i w_ip (v*_i - v_i)) + (1 - f) sum_i w_ip v*_i   (FLIP share f),
+///      x_p <- x_p + dt sum_i w_ip v*_i,   L_p = sum_i v*_i (x) grad w_ip,
+///      F_p <- (I + dt L_p) F_p,   V_p = det(F_p) V_p0.
+/// Each particle reads its own material's node velocities. Rigid particles move with their
+/// prescribed velocity and keep F = I.
+template <int Dim>
+template <class Kernel>
+void MpmSolver<Dim>::gridToParticlesWith(double dt)
+{
+  const Grid<Dim>& grid = layout_->grid();
+  const MaterialTable table = materialTable(materials_);
+  const double flip = options_.flip_fraction;
+  const auto x = particles_.position;
+  const auto v = particles_.velocity;
+  const auto volume = particles_.volume;
+  const auto initial_volume = particles_.initial_volume;
+  const auto F = particles_.deformation_gradient;
+  const auto L = particles_.velocity_gradient;
+  const auto half_width = particles_.half_width;
+  const auto material = particles_.material;
+  const BoxLookup lookup = layout_->nodeLookup();
+  const auto node_v = node_velocity_->view();
+  const auto node_vs = node_velocity_star_->view();
+  double origin[Dim], spacing[Dim];
+  for (int d = 0; d < Dim; ++d) origin[d] = grid.lower()[d], spacing[d] = grid.spacing()[d];
+
+  Kokkos::parallel_for(
+      "mpm::grid_to_particles", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count), KOKKOS_LAMBDA(const int p) {
+        const int m = material(p);
+        if (table.rigid[m]) {
+          for (int d = 0; d < Dim; ++d) {
+            v(p, d) = table.rigid_velocity[m][d];
+            x(p, d) += dt * v(p, d);
+            for (int e = 0; e < Dim; ++e) L(p, d, e) = 0.0;
+          }
+          return;
+        }
+        double xp[Dim], lp[Dim];
+        for (int d = 0; d < Dim; ++d) xp[d] = x(p, d), lp[d] = half_width(p, d);
+        ShapeStencil<Dim, Kernel> s;
+        evaluateShape(xp, origin, spacing, lp, s);
+        double v_grid[Dim] = {}, dv[Dim] = {};
+        Mat<Dim> grad_v;
+        for (int k = 0; k < s.size; ++k) {
+          long long node[3] = {0, 0, 0};
+          s.node(k, node);
+          const LocalOrdinal lid = lookup(node[0], node[1], node[2]);
+          if (lid < 0) continue;
+          const double w = s.weight[k];
+          for (int d = 0; d < Dim; ++d) {
+            const double vs = node_vs(lid, m * Dim + d);
+            v_grid[d] += w * vs;
+            dv[d] += w * (vs - node_v(lid, m * Dim + d));
+            for (int e = 0; e < Dim; ++e) grad_v(d, e) += vs * s.gradient[k][e];
+          }
+        }
+        Mat<Dim> Fp;
+        for (int d = 0; d < Dim; ++d) {
+          v(p, d) = flip * (v(p, d) + dv[d]) + (1.0 - flip) * v_grid[d];
+          x(p, d) += dt * v_grid[d];
+          for (int e = 0; e < Dim; ++e) {
+            L(p, d, e) = grad_v(d, e);
+            Fp(d, e) = F(p, d, e);
+          }
+        }
+        const Mat<Dim> F_new = (Mat<Dim>::identity() + dt * grad_v) * Fp;
+        for (int d = 0; d < Dim; ++d)
+          for (int e = 0; e < Dim; ++e) F(p, d, e) = F_new(d, e);
+        volume(p) = determinant(F_new) * initial_volume(p);
+      });
+}
+
+/// The constitutive update, last in the step (USL), with the velocity gradient of G2P. Dispatch on
+/// the model happens once per material (SolidModel::visit); the kernel holds the concrete model.
+template <int Dim>
+void MpmSolver<Dim>::updateStress(double dt)
+{
+  const auto L = particles_.velocity_gradient;
+  const auto F = particles_.deformation_gradient;
+  const auto sigma = particles_.stress;
+  const auto state = particles_.state;
+  const auto material = particles_.material;
+  const int n = particles_.count;
+
+  // An inverted particle (det F <= 0) means the step was too large or the mesh too coarse.
+  int inverted = n;
+  Kokkos::parallel_reduce(
+      "mpm::check_jacobian", Kokkos::RangePolicy<ExecutionSpace>(0, n),
+      KOKKOS_LAMBDA(const int p, int& first) {
+        Mat<Dim> Fp;
+        for (int d = 0; d < Dim; ++d)
+          for (int e = 0; e < Dim; ++e) Fp(d, e) = F(p, d, e);
+        if (!(determinant(Fp) > 0.0) && p < first) first = p;
+      },
+      Kokkos::Min<int>(inverted));
+  if (inverted < n) {
+    // Raised on every rank by the next relocateParticles (no collective here).
+    std::ostringstream message;
+    message.precision(10);
+    auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), particles_.position);
+    auto id = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), particles_.id);
+    auto m = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), particles_.material);
+    message << "MPM: particle " << id(inverted) << " of material " << materials_[m(inverted)].name
+            << " is inverted (det F <= 0) at (";
+    for (int d = 0; d < Dim; ++d) message << (d ? ", " : "") << x(inverted, d);
+    message << ") m; reduce the time step (rank " << layout_->comm()->getRank() << ")";
+    if (pending_error_.empty()) pending_error_ = message.str();
+  }
+
+  for (int a = 0; a < int(materials_.size()); ++a) {
+    materials_[a].model.visit([&](const auto& model) {
+      Kokkos::parallel_for(
+          "mpm::stress_update", Kokkos::RangePolicy<ExecutionSpace>(0, n), KOKKOS_LAMBDA(const int p) {
+            if (material(p) != a) return;
+            StepKinematics<Dim> kinematics;
+            Mat<Dim> stress;
+            for (int d = 0; d < Dim; ++d)
+              for (int e = 0; e < Dim; ++e) {
+                kinematics.velocity_gradient(d, e) = L(p, d, e);
+                kinematics.deformation_gradient(d, e) = F(p, d, e);
+                stress(d, e) = sigma(p, d, e);
+              }
+            kinematics.dt = dt;
+            MaterialState s = state(p);
+            model.update(kinematics, s, stress);
+            state(p) = s;
+            for (int d = 0; d < Dim; ++d)
+              for (int e = 0; e < Dim; ++e) sigma(p, d, e) = stress(d, e);
+          });
+    });
+  }
+}
+
+template <int Dim>
+MigrationCounts MpmSolver<Dim>::relocateParticles()
+{
+  const std::string error = pending_error_;
+  pending_error_.clear();
+  return (*migration_)(particles_, error);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Time step and diagnostics
+// ---------------------------------------------------------------------------------------------
+
+/// dt = cfl h_min / max_p (c_p + |v_p|), with c_p the material's dilatational wave speed at the
+/// particle's current density m_p / V_p.
+template <int Dim>
+MpmTimeStep MpmSolver<Dim>::stableTimeStep() const
+{
+  const Grid<Dim>& grid = layout_->grid();
+  double h_min = grid.spacing()[0];
+  for (int d = 1; d < Dim; ++d) h_min = std::min(h_min, grid.spacing()[d]);
+  const auto v = particles_.velocity;
+  const auto mass = particles_.mass;
+  const auto volume = particles_.volume;
+  const auto material = particles_.material;
+  const int n = particles_.count;
+
+  using MaxLoc = Kokkos::MaxLoc<double, int>;
+  // Largest signal speed c + |v| (>= 0) and its particle; the reducer starts from -DBL_MAX.
+  double fastest_value = -1.0;
+  int fastest_particle = -1, fastest_material = -1;
+  for (int a = 0; a < int(materials_.size()); ++a) {
+    typename MaxLoc::value_type found;
+    materials_[a].model.visit([&](const auto& model) {
+      Kokkos::parallel_reduce(
+          "mpm::signal_speed", Kokkos::RangePolicy<ExecutionSpace>(0, n),
+          KOKKOS_LAMBDA(const int p, typename MaxLoc::value_type& best) {
+            if (material(p) != a) return;
+            double speed2 = 0.0;
+            for (int d = 0; d < Dim; ++d) speed2 += v(p, d) * v(p, d);
+            const double signal = model.waveSpeed(mass(p) / volume(p)) + math::sqrt(speed2);
+            if (signal > best.val) best.val = signal, best.loc = p;
+          },
+          MaxLoc(found));
+    });
+    if (found.val >= 0.0 && found.val > fastest_value)
+      fastest_value = found.val, fastest_particle = found.loc, fastest_material = a;
+  }
+
+  // The global maximum and the rank that holds it, which then tells the others what limits.
+  struct {
+    double value;
+    int rank;
+  } local{fastest_value, layout_->comm()->getRank()}, global{};
+  const MPI_Comm comm = rawComm(layout_->comm());
+  MPI_Allreduce(&local, &global, 1, MPI_DOUBLE_INT, MPI_MAXLOC, comm);
+  double info[3] = {0.0, 0.0, -1.0};  // wave speed, speed, material
+  if (global.rank == layout_->comm()->getRank() && fastest_particle >= 0) {
+    const int p = fastest_particle;
+    auto vh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), particles_.velocity);
+    double speed2 = 0.0;
+    for (int d = 0; d < Dim; ++d) speed2 += vh(p, d) * vh(p, d);
+    info[1] = std::sqrt(speed2);
+    info[0] = fastest_value - info[1];
+    info[2] = fastest_material;
+  }
+  MPI_Bcast(info, 3, MPI_DOUBLE, global.rank, comm);
+
+  MpmTimeStep result;
+  result.dt = global.value > 0.0 ? cfl_ * h_min / global.value : std::numeric_limits<double>::infinity();
+  result.wave_speed = info[0];
+  result.speed = info[1];
+  if (info[2] >= 0) result.material = materials_[int(info[2])].name;
+  return result;
+}
+
+template <int Dim>
+long long MpmSolver<Dim>::particleCount() const
+{
+  long long local = particles_.count, total = 0;
+  Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_SUM, local, Teuchos::outArg(total));
+  return total;
+}
+
+template <int Dim>
+std::vector<double> MpmSolver<Dim>::materialMasses() const
+{
+  const int nm = int(materials_.size());
+  std::vector<double> local(nm, 0.0), total(nm, 0.0);
+  const auto mass = particles_.mass;
+  const auto material = particles_.material;
+  for (int a = 0; a < nm; ++a)
+    Kokkos::parallel_reduce(
+        "mpm::material_mass", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count),
+        KOKKOS_LAMBDA(const int p, double& sum) {
+          if (material(p) == a) sum += mass(p);
+        },
+        local[a]);
+  if (nm > 0) Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_SUM, nm, local.data(), total.data());
+  return total;
+}
+
+template <int Dim>
+double MpmSolver<Dim>::kineticEnergy() const
+{
+  const auto mass = particles_.mass;
+  const auto v = particles_.velocity;
+  double local = 0.0, total = 0.0;
+  Kokkos::parallel_reduce(
+      "mpm::kinetic_energy", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count),
+      KOKKOS_LAMBDA(const int p, double& sum) {
+        double v2 = 0.0;
+        for (int d = 0; d < Dim; ++d) v2 += v(p, d) * v(p, d);
+        sum += 0.5 * mass(p) * v2;
+      },
+      local);
+  Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_SUM, local, Teuchos::outArg(total));
+  return total;
+}
+
+template <int Dim>
+std::array<double, 3> MpmSolver<Dim>::momentum() const
+{
+  const auto mass = particles_.mass;
+  const auto v = particles_.velocity;
+  double local[3] = {0, 0, 0};
+  std::array<double, 3> total{0, 0, 0};
+  for (int d = 0; d < Dim; ++d)
+    Kokkos::parallel_reduce(
+        "mpm::momentum", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count),
+        KOKKOS_LAMBDA(const int p, double& sum) { sum += mass(p) * v(p, d); }, local[d]);
+  Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_SUM, 3, local, total.data());
+  return total;
+}
+
+template <int Dim>
+ParticleOutput MpmSolver<Dim>::output() const
+{
+  const int n = particles_.count;
+  ParticleOutput out;
+  out.dimension = Dim;
+  out.count = std::size_t(n);
+  auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), particles_.position);
+  auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), particles_.velocity);
+  auto sigma = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), particles_.stress);
+  auto state = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), particles_.state);
+  auto mass = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), particles_.mass);
+  auto volume = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), particles_.volume);
+  auto material = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), particles_.material);
+  auto id = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), particles_.id);
+  out.position.reserve(n * Dim);
+  out.velocity.reserve(n * Dim);
+  out.stress.assign(std::size_t(n) * 9, 0.0);
+  for (int p = 0; p < n; ++p) {
+    for (int d = 0; d < Dim; ++d) {
+      out.position.push_back(x(p, d));
+      out.velocity.push_back(v(p, d));
+      for (int e = 0; e < Dim; ++e) out.stress[p * 9 + 3 * d + e] = sigma(p, d, e);
+    }
+    if (Dim == 2) out.stress[p * 9 + 8] = state(p).out_of_plane_stress;
+    out.plastic_strain.push_back(state(p).equivalent_plastic_strain);
+    out.mass.push_back(mass(p));
+    out.volume.push_back(volume(p));
+    out.material.push_back(materials_[material(p)].scene_index);
+    out.id.push_back(id(p));
+  }
+  return out;
+}
+
+template class MpmSolver<2>;
+template class MpmSolver<3>;
+
+}  // namespace cfdmpm::mpm

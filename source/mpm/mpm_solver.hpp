@@ -1,0 +1,153 @@
+#pragma once
+// The Material Point Method on the scene's grid: the solid materials' particles, their node fields,
+// and one explicit update-stress-last (USL) step in Uintah's order (doc/mpm.md):
+//
+//     particlesToGrid();        // P2G: mass, momentum, internal and external force, mass gradients
+//     integrateGrid(dt);        // v* = (p + dt f) / m; contact between materials; walls
+//     gridToParticles(dt);      // G2P: velocity (PIC/FLIP blend), position, L, F, volume
+//     updateStress(dt);         // constitutive update, once per material through SolidModel
+//     relocateParticles();      // particles go to the rank that owns their cell (MPI)
+//
+// Every particle kernel is a Kokkos parallel_for / parallel_reduce over local views; the parallel
+// parts are the node sum (Field::sumToOwners, a Tpetra Export with ADD) and the migration. The
+// phases are public so that the coupled MPMICE step can call them between its fluid phases.
+#include "fields/field.hpp"
+#include "mpm/migration.hpp"
+#include "mpm/particles.hpp"
+#include "mpm/solid_material.hpp"
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace cfdmpm::mpm {
+
+enum class ShapeFunction {
+  Gimp,   ///< uniform GIMP (Bardenhagen & Kober 2004): no cell-crossing noise; the default
+  Linear  ///< linear hat: classic MPM, kept for comparison
+};
+
+/// Solver settings that the scene file does not (yet) hold; doc/mpm.md explains each.
+struct MpmOptions {
+  ShapeFunction shape_function = ShapeFunction::Gimp;
+  /// Share of FLIP in the G2P velocity update: v_p <- f (v_p + dv_grid) + (1 - f) v_grid.
+  /// 1 = pure FLIP (no numerical dissipation, can be noisy), 0 = pure PIC (very dissipative).
+  double flip_fraction = 0.99;
+  /// Coulomb friction coefficient mu between particles and the free_slip walls of the domain
+  /// (no_slip walls stick). Not in the input file yet.
+  double wall_friction = 0.0;
+  /// Contact between MPM materials (Bardenhagen et al. 2001, Coulomb friction, free separation).
+  /// Off: the materials do not see each other (each has its own node velocities) and pass through
+  /// each other.
+  bool contact = true;
+  double contact_friction = 0.0;  ///< mu between MPM materials
+  /// Mass-proportional damping alpha (1/s): the nodal acceleration gets -alpha v. For reaching
+  /// static states (e.g. a column under self-weight); 0 for dynamics.
+  double velocity_damping = 0.0;
+  /// Courant number of the time step; <= 0 takes the scene's time.cfl.
+  double cfl = 0.0;
+};
+
+/// What the time step is limited by on the whole domain.
+struct MpmTimeStep {
+  double dt = 0.0;         ///< cfl h_min / max_p (c_p + |v_p|) (s); +infinity with no particles
+  double wave_speed = 0.0; ///< c_p of the limiting particle (m/s)
+  double speed = 0.0;      ///< |v_p| of the limiting particle (m/s)
+  std::string material;    ///< name of the limiting particle's material
+};
+
+/// The rank's particles as host arrays for output (HDF5/XDMF), in local order; interleaved
+/// per particle where a quantity has components.
+struct ParticleOutput {
+  int dimension = 2;
+  std::size_t count = 0;
+  std::vector<double> position;        ///< count x dimension (m)
+  std::vector<double> velocity;        ///< count x dimension (m/s)
+  std::vector<double> stress;          ///< count x 9, full 3 x 3 Cauchy stress row by row (Pa)
+  std::vector<double> plastic_strain;  ///< equivalent plastic strain (-)
+  std::vector<double> mass;            ///< kg (kg/m in 2-D)
+  std::vector<double> volume;          ///< m^3 (m^2 in 2-D)
+  std::vector<int> material;           ///< index in Scene::materials
+  std::vector<long long> id;           ///< particle id
+};
+
+template <int Dim>
+class MpmSolver {
+ public:
+  /// Seeds the particles of every solid material of the scene in the layout's owned cells.
+  /// Collective. The layout needs ghost_width >= 1 (GIMP reaches one cell beyond a particle's own).
+  MpmSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>> layout, const MpmOptions& options = {});
+
+  // --- the step --------------------------------------------------------------------------------
+  /// Largest stable time step over all ranks (collective).
+  MpmTimeStep stableTimeStep() const;
+  /// One USL step of length dt (collective): the five phases below in order.
+  void step(double dt);
+
+  void particlesToGrid();
+  void integrateGrid(double dt);
+  void gridToParticles(double dt);
+  /// Stress update; an inverted particle (det F <= 0) is reported by the next relocateParticles.
+  void updateStress(double dt);
+  /// Particles to the ranks that own their cells; raises (on every rank) the errors found since
+  /// the last call: a particle outside the domain, an inverted one, or a P2G that reached beyond
+  /// the ghost nodes. Phases report errors here so that the step has no extra collective.
+  MigrationCounts relocateParticles();
+
+  /// Moves to a new decomposition of the same grid (dynamic load balancing): new node fields, and
+  /// the particles go to their new owners. Collective.
+  void repartition(std::shared_ptr<const Layout<Dim>> layout);
+
+  /// Gravity (m/s^2; entries beyond Dim ignored); starts as the scene's domain.gravity.
+  void setGravity(const std::array<double, 3>& gravity);
+  const std::array<double, 3>& gravity() const { return gravity_; }
+
+  // --- diagnostics (collective) ------------------------------------------------------------------
+  long long particleCount() const;
+  std::vector<double> materialMasses() const;   ///< per MPM material (kg, or kg/m in 2-D)
+  double kineticEnergy() const;                 ///< sum of m |v|^2 / 2 (J, or J/m in 2-D)
+  std::array<double, 3> momentum() const;       ///< sum of m v (entries beyond Dim zero)
+
+  // --- access ------------------------------------------------------------------------------------
+  const std::vector<SolidMaterial>& materials() const { return materials_; }
+  const MpmOptions& options() const { return options_; }
+  Particles<Dim>& particles() { return particles_; }
+  const Particles<Dim>& particles() const { return particles_; }
+  const Layout<Dim>& layout() const { return *layout_; }
+  /// Host copies of the rank's particles for output.
+  ParticleOutput output() const;
+
+  /// Node fields of the last P2G / grid update: mass per material, and the velocities before (v)
+  /// and after (v*) the grid update, material m component d in column m * Dim + d.
+  const Field<Dim>& nodeSums() const { return *node_sums_; }
+  const Field<Dim>& nodeVelocity() const { return *node_velocity_; }
+  const Field<Dim>& nodeVelocityStar() const { return *node_velocity_star_; }
+
+ private:
+  template <class Kernel>
+  void particlesToGridWith();
+  template <class Kernel>
+  void gridToParticlesWith(double dt);
+  void allocateNodeFields();
+
+  std::shared_ptr<const Layout<Dim>> layout_;
+  MpmOptions options_;
+  double cfl_;
+  std::vector<SolidMaterial> materials_;
+  std::array<double, 3> gravity_{0, 0, 0};
+  std::array<int, 2 * Dim> wall_no_slip_{};  // per face: 1 no_slip, 0 free_slip
+  double empty_node_mass_ = 0.0;             // below this a node holds no material (kg)
+  std::string pending_error_;                // found by a phase, raised collectively by relocateParticles
+
+  Particles<Dim> particles_;
+  std::unique_ptr<ParticleMigration<Dim>> migration_;
+  std::unique_ptr<Field<Dim>> node_sums_;           // mass, momentum, force, mass gradient
+  std::unique_ptr<Field<Dim>> node_velocity_;       // v = p / m
+  std::unique_ptr<Field<Dim>> node_velocity_star_;  // v* after forces, contact and walls
+};
+
+extern template class MpmSolver<2>;
+extern template class MpmSolver<3>;
+
+}  // namespace cfdmpm::mpm

@@ -1,0 +1,27 @@
+#pragma once
+// The solid (MPM) materials of a scene: density, particles per cell and the constitutive model,
+// read once from each `kind: solid` material's validated parameter list (doc/input.md).
+#include "input/scene.hpp"
+#include "mpm/constitutive/solid_model.hpp"
+
+#include <string>
+#include <vector>
+
+namespace cfdmpm::mpm {
+
+struct SolidMaterial {
+  std::string name;
+  int scene_index = 0;         ///< index of the material in Scene::materials (output, regions)
+  double density = 0.0;        ///< kg/m^3 at rest
+  int particles_per_cell = 2;  ///< material points per cell in each direction
+  SolidModel model;            ///< constitutive model (a value type; no virtual calls)
+};
+
+/// The constitutive model described by a material's `model` sublist (keys of doc/input.md).
+SolidModel solidModelFromParameters(const Teuchos::ParameterList& model, const std::string& material_name);
+
+/// The scene's solid materials in scene order; the position in the returned list is the MPM
+/// material index that particles carry. Throws InputError naming the key for bad parameters.
+std::vector<SolidMaterial> solidMaterials(const Scene& scene);
+
+}  // namespace cfdmpm::mpm

@@ -19,6 +19,9 @@
 #include "input/scene.hpp"
 #include "mpmice/cell_state.hpp"
 
+#include <Teuchos_Time.hpp>
+
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -74,6 +77,12 @@ class IceSolver {
 
   const IceSettings& settings() const { return settings_; }
 
+  /// The phases timed by Teuchos timers named "ice: <phase>" ("step" is the whole step).
+  static constexpr const char* kPhases[] = {"step", "equilibration", "face velocities", "pressure",
+                                            "momentum and exchange", "advection"};
+  /// Wall seconds spent in a phase on this rank since the program started.
+  double phaseSeconds(const std::string& phase) const { return timers_.at(phase)->totalElapsedTime(); }
+
  private:
   void faceVelocities(const CellState<Dim>& state, double dt);
   void faceExchange(const CellState<Dim>& state, double dt);
@@ -102,6 +111,7 @@ class IceSolver {
   Field<Dim> new_velocity_;             // work array of the momentum update
   std::unique_ptr<PressureSolver<Dim>> pressure_solver_;
   std::unique_ptr<Advector<Dim>> advector_;
+  std::map<std::string, Teuchos::RCP<Teuchos::Time>> timers_;
 };
 
 extern template class IceSolver<2>;

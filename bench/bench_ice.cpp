@@ -7,6 +7,8 @@
 //   reuse: full MueLu set-up every `reuse` solves (the pressure solver's "reuse interval")
 #include "ice_scene_support.hpp"
 
+#include "bench_support.hpp"
+
 #include <Tpetra_Core.hpp>
 
 #include <chrono>
@@ -14,26 +16,6 @@
 #include <iostream>
 
 using namespace cfdmpm;
-
-namespace {
-
-// Seconds per pass of a = b + s c over n doubles (best of 5).
-double triadSeconds(std::size_t n)
-{
-  Kokkos::View<double*> a("a", n), b("b", n), c("c", n);
-  Kokkos::deep_copy(b, 1.0);
-  Kokkos::deep_copy(c, 2.0);
-  double best = 1e300;
-  for (int r = 0; r < 5; ++r) {
-    const auto start = std::chrono::steady_clock::now();
-    Kokkos::parallel_for("triad", n, KOKKOS_LAMBDA(const std::size_t i) { a(i) = b(i) + 0.5 * c(i); });
-    Kokkos::fence();
-    best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-  }
-  return best;
-}
-
-}  // namespace
 
 int main(int argc, char** argv)
 {
@@ -44,27 +26,8 @@ int main(int argc, char** argv)
     const long long nx = argc > 2 ? std::atoll(argv[1]) : 840, ny = argc > 2 ? std::atoll(argv[2]) : 336;
     const int steps = argc > 3 ? std::atoi(argv[3]) : 20;
     const int reuse = argc > 4 ? std::atoi(argv[4]) : 1;
-    const Scene scene = test::sceneFromYaml(R"(
-cfdmpm:
-  domain: {dimension: 2, lower: [0.0, 0.0], upper: [0.5, 0.2], cells: [)" + std::to_string(nx) + ", " +
-                                            std::to_string(ny) + R"(], patch_cells: [64, 64], gravity: [0.0, -9.81]}
-  materials:
-    water:
-      kind: fluid
-      equation_of_state: {type: linear_water, bulk_modulus: 2.15e9, reference_density: 998.0, reference_pressure: 101325.0, reference_temperature: 293.15}
-      viscosity: 1.0e-3
-      specific_heat: 4157.0
-    air:
-      kind: fluid
-      equation_of_state: {type: ideal_gas, gas_constant: 287.0, gamma: 1.4}
-      viscosity: 1.8e-5
-  initial_state: {background_material: air, temperature: 293.15, pressure: 101325.0}
-  regions:
-    column: {material: water, shape: box, lower: [0.0, 0.0], upper: [0.05715, 0.1143]}
-  time: {end_time: 0.25}
-  output: {directory: unused, interval: 0.01}
-  ice: {linear_solver: {reuse interval: )" + std::to_string(reuse) + R"(}}
-)");
+    const Scene scene = test::damBreakScene(nx, ny, 64, "{linear_solver: {reuse interval: " + std::to_string(reuse) + "}}");
+
     test::IceRun<2> run(scene, comm);
     const double dt = 2e-5;  // s: ~CFL 0.25 for the flow at 0.6 mm cells once it moves
     run.runUntil(5 * dt, dt);  // warm-up: allocations, first MueLu set-up
@@ -77,7 +40,7 @@ cfdmpm:
     }
     const double cells = double(nx * ny);
     const int ranks = comm->getSize();
-    const double triad = triadSeconds(std::size_t(cells / ranks) * 10);  // 10 doubles per cell
+    const double triad = bench::triadSeconds(std::size_t(cells / ranks) * 10);  // 10 doubles per cell
     if (root) {
       std::cout << std::fixed << std::setprecision(3) << "ICE dam break, " << nx << " x " << ny << " = " << cells
                 << " cells, " << ranks << " rank(s), " << steps << " steps of " << std::scientific << dt

@@ -9,6 +9,8 @@
 #include "mpm/mpm_solver.hpp"
 #include "mpm_scene_builder.hpp"
 
+#include "bench_support.hpp"
+
 #include <Tpetra_Core.hpp>
 
 #include <chrono>
@@ -18,21 +20,6 @@
 using namespace cfdmpm;
 
 namespace {
-
-double triadSeconds(std::size_t n)
-{
-  Kokkos::View<double*> a("a", n), b("b", n), c("c", n);
-  Kokkos::deep_copy(b, 1.0);
-  Kokkos::deep_copy(c, 2.0);
-  double best = 1e300;
-  for (int r = 0; r < 5; ++r) {
-    const auto start = std::chrono::steady_clock::now();
-    Kokkos::parallel_for("triad", n, KOKKOS_LAMBDA(const std::size_t i) { a(i) = b(i) + 0.5 * c(i); });
-    Kokkos::fence();
-    best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-  }
-  return best;
-}
 
 double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
@@ -89,7 +76,7 @@ int main(int argc, char** argv)
     const double total = now() - start;
     const long long particles = solver.particleCount();
     const int ranks = comm->getSize();
-    const double triad = triadSeconds(std::size_t(particles / ranks) * 10);
+    const double triad = bench::triadSeconds(std::size_t(particles / ranks) * 10);
     if (root) {
       std::cout << std::fixed << std::setprecision(3) << "MPM step, " << particles << " particles, " << nx << " x "
                 << ny << " cells, " << ranks << " rank(s), " << steps << " steps\n"

@@ -32,6 +32,33 @@ inline Scene sceneFromYaml(const std::string& text)
   return scene;
 }
 
+/// The Martin & Moyce dam break (0.5 m x 0.2 m tank, water column 0.05715 m x 0.1143 m, air above)
+/// on nx x ny cells; `ice_section` is the YAML flow map of the `ice` settings.
+inline Scene damBreakScene(long long nx, long long ny, long long patch, const std::string& ice_section = "{}")
+{
+  return sceneFromYaml(R"(
+cfdmpm:
+  domain: {dimension: 2, lower: [0.0, 0.0], upper: [0.5, 0.2], cells: [)" + std::to_string(nx) + ", " +
+                       std::to_string(ny) + "], patch_cells: [" + std::to_string(patch) + ", " + std::to_string(patch) +
+                       R"(], gravity: [0.0, -9.81]}
+  materials:
+    water:
+      kind: fluid
+      equation_of_state: {type: linear_water, bulk_modulus: 2.15e9, reference_density: 998.0, reference_pressure: 101325.0, reference_temperature: 293.15}
+      viscosity: 1.0e-3
+      specific_heat: 4157.0
+    air:
+      kind: fluid
+      equation_of_state: {type: ideal_gas, gas_constant: 287.0, gamma: 1.4}
+      viscosity: 1.8e-5
+  initial_state: {background_material: air, temperature: 293.15, pressure: 101325.0}
+  regions:
+    column: {material: water, shape: box, lower: [0.0, 0.0], upper: [0.05715, 0.1143]}
+  time: {end_time: 0.25, dt_initial: 1.0e-4}
+  output: {directory: unused, interval: 0.01}
+  ice: )" + ice_section + "\n");
+}
+
 /// A scene's state and solver on a communicator.
 template <int Dim>
 struct IceRun {

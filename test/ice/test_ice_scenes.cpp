@@ -61,18 +61,6 @@ std::vector<double> gatherField(const Field<2>& field)
   return total;
 }
 
-const char* kWaterAndAir = R"(
-  materials:
-    water:
-      kind: fluid
-      equation_of_state: {type: linear_water, bulk_modulus: 2.15e9, reference_density: 998.0, reference_pressure: 101325.0, reference_temperature: 293.15}
-      viscosity: 1.0e-3
-      specific_heat: 4157.0
-    air:
-      kind: fluid
-      equation_of_state: {type: ideal_gas, gas_constant: 287.0, gamma: 1.4}
-      viscosity: 1.8e-5
-)";
 
 }  // namespace
 
@@ -227,18 +215,7 @@ TEST(IceScenes, DamBreakIsTheSameOnOneAndTwoRanks)
   // ranks. Partitions change only the order of sums in the linear solver and the reductions, so the
   // runs differ by what the linear solver leaves: with its tolerance at 1e-14 (relative residual),
   // fields agree to 1e-10 relative to their scale.
-  const std::string text = std::string(R"(
-cfdmpm:
-  domain: {dimension: 2, lower: [0.0, 0.0], upper: [0.5, 0.2], cells: [50, 20], patch_cells: [10, 10], gravity: [0.0, -9.81]}
-)") + kWaterAndAir + R"(
-  initial_state: {background_material: air, temperature: 293.15, pressure: 101325.0}
-  regions:
-    column: {material: water, shape: box, lower: [0.0, 0.0], upper: [0.05715, 0.1143]}
-  time: {end_time: 0.25, dt_initial: 1.0e-4}
-  output: {directory: unused, interval: 0.01}
-  ice: {solver_tolerance: 1.0e-14}
-)";
-  const Scene scene = sceneFromYaml(text);
+  const Scene scene = damBreakScene(50, 20, 10, "{solver_tolerance: 1.0e-14}");
   const auto comm = world();
   auto runOn = [&](const Teuchos::RCP<const Teuchos::Comm<int>>& c) {
     IceRun<2> run(scene, c);

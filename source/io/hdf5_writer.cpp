@@ -156,6 +156,11 @@ struct Hdf5Writer::OpenStep {
   std::string temporary_path;
   std::string final_path;
   WrittenStep record;
+  // Particles of this step: set by the first particle field.
+  bool have_particles = false;
+  std::size_t particle_local = 0;    // this rank's particles
+  long long particle_offset = 0;     // particles on the ranks before this one
+  long long particle_total = 0;
 };
 
 Hdf5Writer::Hdf5Writer(MPI_Comm comm, std::string directory, std::string run_name,
@@ -258,13 +263,11 @@ void Hdf5Writer::writeField(OutputLocation location, const std::string& name, in
                             const double* values, std::size_t count)
 {
   if (!open_) throw std::logic_error("Hdf5Writer: write '" + name + "' outside beginStep/endStep");
-  checkFieldName(name);
+  if (location == OutputLocation::Particles)
+    throw std::invalid_argument("Hdf5Writer: particle field '" + name +
+                                "' goes through writeParticleScalar/writeParticleVector");
+  checkNewField(location, name);
   const std::string dataset_path = std::string("/") + locationName(location) + "/" + name;
-  for (const WrittenField& field : open_->record.fields)
-    if (field.location == location &&
-        (field.name == name || isPathPrefix(field.name, name) || isPathPrefix(name, field.name)))
-      throw std::invalid_argument("output field '" + dataset_path + "' clashes with '" +
-                                  field.dataset + "' already written in this step");
 
   const OutputLayout& grid = layout(location);
   const std::size_t expected = static_cast<std::size_t>(ownedCount(grid)) * components;
@@ -288,6 +291,120 @@ void Hdf5Writer::writeField(OutputLocation location, const std::string& name, in
     writeDataset(grid, field.display_dataset, 3, padded.data(), padded.size());
   }
   open_->record.fields.push_back(std::move(field));
+}
+
+void Hdf5Writer::checkNewField(OutputLocation location, const std::string& name)
+{
+  checkFieldName(name);
+  const std::string dataset_path = std::string("/") + locationName(location) + "/" + name;
+  for (const WrittenField& field : open_->record.fields)
+    if (field.location == location &&
+        (field.name == name || isPathPrefix(field.name, name) || isPathPrefix(name, field.name)))
+      throw std::invalid_argument("output field '" + dataset_path + "' clashes with '" +
+                                  field.dataset + "' already written in this step");
+}
+
+void Hdf5Writer::writeParticleScalar(const std::string& name, const double* values,
+                                     std::size_t local_count)
+{
+  writeParticleField(name, 1, values, local_count);
+}
+
+void Hdf5Writer::writeParticleVector(const std::string& name, const double* values,
+                                     std::size_t local_count, int components)
+{
+  writeParticleField(name, components, values, local_count);
+}
+
+void Hdf5Writer::writeParticleField(const std::string& name, int components, const double* values,
+                                    std::size_t local_count)
+{
+  if (!open_) throw std::logic_error("Hdf5Writer: write '" + name + "' outside beginStep/endStep");
+  checkNewField(OutputLocation::Particles, name);
+  const std::string dataset_path = "/particles/" + name;
+  if (anyRank(comm_, components < 1 || (local_count > 0 && values == nullptr) ||
+                         (open_->have_particles && local_count != open_->particle_local)))
+    throw std::invalid_argument(
+        "output field '" + dataset_path + "': " +
+        (components < 1 ? std::string("components must be at least 1")
+         : open_->have_particles && local_count != open_->particle_local
+             ? "a rank passed " + std::to_string(local_count) + " particles, earlier fields of this step " +
+                   std::to_string(open_->particle_local)
+             : std::string("a rank passed wrong buffer sizes or particle counts")));
+
+  if (!open_->have_particles) {
+    long long local = static_cast<long long>(local_count), offset = 0, total = 0;
+    MPI_Exscan(&local, &offset, 1, MPI_LONG_LONG, MPI_SUM, comm_);
+    if (rankOf(comm_) == 0) offset = 0;  // MPI_Exscan leaves rank 0's result undefined
+    MPI_Allreduce(&local, &total, 1, MPI_LONG_LONG, MPI_SUM, comm_);
+    H5Handle group(checked(H5Gcreate2(open_->file.get(), "particles", H5P_DEFAULT, H5P_DEFAULT,
+                                      H5P_DEFAULT),
+                           "creating group /particles"),
+                   H5Gclose);
+    writeAttribute(group.get(), "count", H5T_NATIVE_LLONG, H5T_STD_I64LE, &total, 1);
+    open_->have_particles = true;
+    open_->particle_local = local_count;
+    open_->particle_offset = offset;
+    open_->particle_total = total;
+  }
+
+  const long long n = open_->particle_total;
+  std::vector<long long> dims{n};
+  if (components > 1) dims.push_back(components);
+  writeParticleDataset(dataset_path, components, values, local_count);
+  WrittenField field{OutputLocation::Particles, name, dataset_path, components, dims, dataset_path, dims};
+  if (components == 2) {
+    std::vector<double> padded(local_count * 3, 0.0);
+    for (std::size_t p = 0; p < local_count; ++p) {
+      padded[3 * p] = values[2 * p];
+      padded[3 * p + 1] = values[2 * p + 1];
+    }
+    field.display_dataset = "/padded/particles/" + name;
+    field.display_dims = {n, 3};
+    writeParticleDataset(field.display_dataset, 3, padded.data(), local_count);
+  }
+  open_->record.fields.push_back(std::move(field));
+}
+
+void Hdf5Writer::writeParticleDataset(const std::string& dataset_path, int components,
+                                      const double* values, std::size_t local_count)
+{
+  // File: (N) or (N, components); this rank's rows [offset, offset + local_count).
+  std::vector<hsize_t> file_dims{static_cast<hsize_t>(open_->particle_total)};
+  std::vector<hsize_t> start{static_cast<hsize_t>(open_->particle_offset)};
+  std::vector<hsize_t> extent{static_cast<hsize_t>(local_count)};
+  if (components > 1) {
+    file_dims.push_back(static_cast<hsize_t>(components));
+    start.push_back(0);
+    extent.push_back(static_cast<hsize_t>(components));
+  }
+  H5Handle file_space(checked(H5Screate_simple(static_cast<int>(file_dims.size()), file_dims.data(),
+                                               nullptr),
+                              "file dataspace"),
+                      H5Sclose);
+  if (local_count > 0)
+    checked(H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start.data(), nullptr,
+                                extent.data(), nullptr),
+            "selecting this rank's particles");
+  else
+    checked(H5Sselect_none(file_space.get()), "H5Sselect_none");
+
+  const std::size_t count = local_count * static_cast<std::size_t>(components);
+  const hsize_t memory_length = count > 0 ? static_cast<hsize_t>(count) : 1;
+  H5Handle memory_space(checked(H5Screate_simple(1, &memory_length, nullptr), "memory dataspace"),
+                        H5Sclose);
+  if (count == 0) checked(H5Sselect_none(memory_space.get()), "H5Sselect_none");
+  static const double no_values = 0;
+
+  // Dataset creation is collective and needs the whole dataspace, whatever is selected.
+  H5Handle dataset(checked(H5Dcreate2(open_->file.get(), dataset_path.c_str(), H5T_IEEE_F64LE,
+                                      file_space.get(), open_->link_creation.get(),
+                                      open_->dataset_creation.get(), H5P_DEFAULT),
+                           "creating dataset " + dataset_path),
+                   H5Dclose);
+  checked(H5Dwrite(dataset.get(), H5T_NATIVE_DOUBLE, memory_space.get(), file_space.get(),
+                   open_->transfer.get(), count > 0 ? values : &no_values),
+          "writing dataset " + dataset_path);
 }
 
 hid_t Hdf5Writer::fileSelection(const OutputLayout& grid, int components)

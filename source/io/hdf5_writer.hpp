@@ -6,8 +6,13 @@
 //     /cells      attributes count_xyz, origin_xyz, spacing_xyz; one dataset per cell field
 //     /nodes      the same for node fields
 //
+//     /particles  attribute count (int64, over all ranks); one dataset per particle field, dims
+//                 (N) for a scalar, (N, components) for a vector or tensor, rank 0's particles
+//                 first, then rank 1's, ...; only in steps that write particle fields
+//
 //     /padded     2-D only: /padded/cells/<name>, /padded/nodes/<name>, each 2-D vector field
-//                 again with a zero third component, for ParaView (its vectors have 3 components)
+//                 again with a zero third component, for ParaView (its vectors have 3 components);
+//                 /padded/particles/<name> for 2-component particle fields (position, velocity)
 //
 // A field name may contain slashes ("water/volume_fraction" becomes /cells/water/volume_fraction;
 // the groups on the way are created). Datasets are float64 with dims (nz, ny, nx) in 3-D and
@@ -35,8 +40,8 @@ struct WrittenField {
   OutputLocation location = OutputLocation::Cells;
   std::string name;             // as given, e.g. "water/volume_fraction"
   std::string dataset;          // path in the file, e.g. "/cells/water/volume_fraction"
-  int components = 1;           // 1: scalar; dimension: vector
-  std::vector<long long> dims;  // HDF5 dims, slowest first
+  int components = 1;           // 1: scalar; dimension: vector; particles: any (9: stress tensor)
+  std::vector<long long> dims;  // HDF5 dims, slowest first; particles: {N} or {N, components}
   // What a visualisation reads: the dataset itself, except for 2-D vectors, whose (x, y, 0)
   // copy lives at /padded/<location>/<name> with 3 components (ParaView's vectors have three).
   std::string display_dataset;
@@ -76,6 +81,19 @@ class Hdf5Writer {
   void writeVector(OutputLocation location, const std::string& name, const double* values,
                    std::size_t count);
 
+  /// Particle fields (location Particles, group /particles). `local_count` is the number of this
+  /// rank's particles (not of doubles); the ranks' particles are stored one after the other in rank
+  /// order, each rank at the offset given by MPI_Exscan of the counts. A rank without particles
+  /// passes 0 (values may be null) and still takes part. The first particle field of a step creates
+  /// /particles with the attribute count (the total); every later one must have the same
+  /// local_count on every rank (std::invalid_argument otherwise). The count may differ from step to
+  /// step. A field named "position" is what the XDMF sidecar uses as the particles' geometry.
+  void writeParticleScalar(const std::string& name, const double* values, std::size_t local_count);
+  /// `components` values per particle, interleaved (values[particle * components + c]), e.g. the
+  /// position with the grid dimension's components or the stress with 9 (row by row).
+  void writeParticleVector(const std::string& name, const double* values, std::size_t local_count,
+                           int components);
+
   /// Closes the file, renames it to its final name (rank 0) and returns what was written.
   WrittenStep endStep();
 
@@ -91,6 +109,11 @@ class Hdf5Writer {
   void writeDataset(const OutputLayout& grid, const std::string& path, int components,
                     const double* values, std::size_t count);
   std::int64_t fileSelection(const OutputLayout& grid, int components);  // an HDF5 dataspace id
+  void writeParticleField(const std::string& name, int components, const double* values,
+                          std::size_t local_count);
+  void writeParticleDataset(const std::string& path, int components, const double* values,
+                            std::size_t local_count);
+  void checkNewField(OutputLocation location, const std::string& name);
   void abandonStep() noexcept;
 
   MPI_Comm comm_;

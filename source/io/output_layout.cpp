@@ -4,7 +4,12 @@ namespace cfdmpm {
 
 const char* locationName(OutputLocation location)
 {
-  return location == OutputLocation::Cells ? "cells" : "nodes";
+  switch (location) {
+    case OutputLocation::Cells: return "cells";
+    case OutputLocation::Nodes: return "nodes";
+    case OutputLocation::Particles: return "particles";
+  }
+  return "cells";
 }
 
 long long ownedCount(const OutputLayout& layout)

@@ -23,9 +23,11 @@ struct OutputLayout {                       // one per location (cells or nodes)
   std::vector<Box> owned_boxes;             // this rank's boxes (disjoint; union over ranks = all)
 };
 
-enum class OutputLocation { Cells, Nodes };
+/// Where a field lives: on the grid's cells or nodes, or on the particles (a list of points whose
+/// count may change from step to step; no OutputLayout, see Hdf5Writer::writeParticleScalar).
+enum class OutputLocation { Cells, Nodes, Particles };
 
-/// "cells" or "nodes": the HDF5 group of a location.
+/// "cells", "nodes" or "particles": the HDF5 group of a location.
 const char* locationName(OutputLocation location);
 
 /// Entries owned by this rank (sum of the boxes' counts).

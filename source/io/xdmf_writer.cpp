@@ -51,11 +51,23 @@ std::vector<long long> nodeDims(const OutputLayout& cells)
   return dims;
 }
 
+/// XDMF AttributeType for a field with this many components.
+const char* attributeType(int components)
+{
+  switch (components) {
+    case 1: return "Scalar";
+    case 2:
+    case 3: return "Vector";
+    case 6: return "Tensor6";
+    case 9: return "Tensor";
+    default: return "Matrix";
+  }
+}
+
 std::string attribute(const std::string& file, const WrittenField& field, const std::string& pad)
 {
-  const bool vector = field.components > 1;
   return pad + "<Attribute Name=\"" + escaped(field.name) + "\" AttributeType=\"" +
-         (vector ? "Vector" : "Scalar") + "\" Center=\"" +
+         attributeType(field.components) + "\" Center=\"" +
          (field.location == OutputLocation::Cells ? "Cell" : "Node") + "\">\n" + pad +
          "  <DataItem Dimensions=\"" + dimensionList(field.display_dims) +
          "\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" + escaped(file) + ":" +
@@ -101,8 +113,44 @@ std::string xdmfGrid(const OutputLayout& cells, const WrittenStep& step, int ind
   out += pad + "    <DataItem Name=\"Spacing\" Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" "
                "Format=\"XML\">" + spacing + "</DataItem>\n";
   out += pad + "  </Geometry>\n";
-  for (const WrittenField& field : step.fields) out += attribute(step.file, field, pad + "  ");
+  for (const WrittenField& field : step.fields)
+    if (field.location != OutputLocation::Particles) out += attribute(step.file, field, pad + "  ");
   return out + pad + "</Grid>\n";
+}
+
+std::string xdmfParticleGrid(const WrittenStep& step, int indent)
+{
+  const WrittenField* position = nullptr;
+  for (const WrittenField& field : step.fields)
+    if (field.location == OutputLocation::Particles && field.name == "position") position = &field;
+  if (!position || position->dims.empty() || position->dims[0] == 0 ||
+      position->display_dims.size() != 2 || position->display_dims[1] != 3)
+    return {};
+  const long long count = position->dims[0];
+  const std::string pad(static_cast<std::size_t>(indent), ' ');
+  std::string out = pad + "<Grid Name=\"particles\" GridType=\"Uniform\">\n";
+  out += pad + "  <Time Value=\"" + number(step.time) + "\"/>\n";
+  out += pad + "  <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" + std::to_string(count) +
+         "\" NodesPerElement=\"1\"/>\n";
+  out += pad + "  <Geometry GeometryType=\"XYZ\">\n";
+  out += pad + "    <DataItem Dimensions=\"" + dimensionList(position->display_dims) +
+         "\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" + escaped(step.file) + ":" +
+         escaped(position->display_dataset) + "</DataItem>\n";
+  out += pad + "  </Geometry>\n";
+  for (const WrittenField& field : step.fields)
+    if (field.location == OutputLocation::Particles) out += attribute(step.file, field, pad + "  ");
+  return out + pad + "</Grid>\n";
+}
+
+std::string xdmfStep(const OutputLayout& cells, const WrittenStep& step, int indent)
+{
+  const std::string particles = xdmfParticleGrid(step, indent + 2);
+  if (particles.empty()) return xdmfGrid(cells, step, indent);
+  const std::string pad(static_cast<std::size_t>(indent), ' ');
+  return pad + "<Grid Name=\"" + escaped(stem(step.file)) +
+         "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n" + pad + "  <Time Value=\"" +
+         number(step.time) + "\"/>\n" + xdmfGrid(cells, step, indent + 2) + particles + pad +
+         "</Grid>\n";
 }
 
 void writeFileAtomically(const std::string& path, const std::string& text)
@@ -154,12 +202,12 @@ void XdmfWriter::addStep(const WrittenStep& step)
   if (!replaced) steps_.push_back(step);
 
   io_detail::onRankZero(comm_, [&] {
-    writeFileAtomically(stepPath(step), documentHead() + xdmfGrid(cells_, step, 4) + documentTail());
+    writeFileAtomically(stepPath(step), documentHead() + xdmfStep(cells_, step, 4) + documentTail());
 
     std::string series = documentHead();
     series += "    <Grid Name=\"" + escaped(run_name_) +
               "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-    for (const WrittenStep& written : steps_) series += xdmfGrid(cells_, written, 6);
+    for (const WrittenStep& written : steps_) series += xdmfStep(cells_, written, 6);
     series += "    </Grid>\n" + documentTail();
     writeFileAtomically(seriesPath(), series);
   });

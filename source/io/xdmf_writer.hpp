@@ -6,6 +6,11 @@
 //                                  or Node, AttributeType Scalar or Vector)
 //   <directory>/<run>.xmf          the time series: a Temporal Collection of every step so far
 //
+// A step with particle fields (and a particle field "position") is a Spatial Collection of two
+// uniform grids instead: the cell/node grid as above and "particles", a Polyvertex grid with XYZ
+// geometry (the /padded 3-component copy of the position in 2-D) and Center="Node" attributes
+// (AttributeType Scalar, Vector, Tensor for 9 components, Tensor6 for 6, Matrix otherwise).
+//
 // Both are written to <name>.tmp and renamed, so a reader never sees half a file. XDMF orders
 // dimensions, origin and spacing slowest first (z y x), like the HDF5 datasets.
 //
@@ -26,7 +31,18 @@ namespace cfdmpm {
 
 /// The XML of one uniform grid element (topology, geometry, time, attributes) for a written step;
 /// `indent` spaces before each line. HDF5 references are relative to the output directory.
+/// Only the cell and node fields; the particles have their own grid (xdmfParticleGrid).
 std::string xdmfGrid(const OutputLayout& cells, const WrittenStep& step, int indent);
+
+/// The particles of a step as a uniform grid named "particles": Polyvertex topology with one
+/// element per particle, XYZ geometry from the particle field "position" (its /padded copy in
+/// 2-D), one Center="Node" attribute per particle field. Empty if the step has no particle field
+/// "position" or no particles at all.
+std::string xdmfParticleGrid(const WrittenStep& step, int indent);
+
+/// What a step contributes to a file: xdmfGrid alone when there is no particle grid, otherwise a
+/// Spatial collection (with the step's Time) holding the cell/node grid and then the particle grid.
+std::string xdmfStep(const OutputLayout& cells, const WrittenStep& step, int indent);
 
 class XdmfWriter {
  public:

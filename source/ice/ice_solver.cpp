@@ -46,17 +46,21 @@ IceSettings IceSettings::fromScene(const Scene& scene)
   IceSettings s;
   const Teuchos::ParameterList& ice = scene.parameters->isSublist("ice") ? scene.parameters->sublist("ice")
                                                                         : Teuchos::ParameterList();
-  static const char* known[] = {"pressure", "exchange_coefficient", "max_outer_iterations", "outer_tolerance",
+  static const char* known[] = {"enabled", "pressure", "exchange_coefficient", "max_outer_iterations", "outer_tolerance",
                                 "solver_tolerance", "dt_growth", "linear_solver"};
   for (auto it = ice.begin(); it != ice.end(); ++it) {
     const std::string& key = ice.name(it);
     bool ok = false;
     for (const char* k : known) ok = ok || key == k;
     if (!ok)
-      throw InputError("cfdmpm.ice." + key + ": unknown key; allowed keys in cfdmpm.ice: pressure, "
+      throw InputError("cfdmpm.ice." + key + ": unknown key; allowed keys in cfdmpm.ice: enabled, pressure, "
                        "exchange_coefficient, max_outer_iterations, outer_tolerance, solver_tolerance, "
                        "dt_growth, linear_solver");
   }
+  if (ice.isParameter("enabled") && !ice.isType<bool>("enabled"))
+    throw InputError("cfdmpm.ice.enabled: got a " + ice.getEntry("enabled").getAny().typeName() +
+                     "; expected true or false");
+  s.enabled = getOr<bool>(ice, "enabled", s.enabled);
   s.pressure = getOr<std::string>(ice, "pressure", s.pressure);
   if (s.pressure != "implicit" && s.pressure != "explicit")
     throw inputError("cfdmpm.ice.pressure", s.pressure, "allowed: implicit, explicit");

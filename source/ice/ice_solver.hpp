@@ -30,6 +30,7 @@ namespace cfdmpm {
 
 /// Settings of the ICE step, from the scene's `ice` section (doc/input.md).
 struct IceSettings {
+  bool enabled = true;                   // false: fluids are an inert background (dry scenes)
   std::string pressure = "implicit";     // "implicit" or "explicit" (for comparison)
   double exchange_coefficient = 1e15;    // momentum exchange K between every pair (kg/(m^3 s))
   int max_outer_iterations = 20;

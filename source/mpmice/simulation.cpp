@@ -2,6 +2,7 @@
 
 #include "ice/ice_solver.hpp"
 #include "ice/material_eos.hpp"
+#include "mpm/mpm_solver.hpp"
 #include "io/output_directory.hpp"
 #include "io/progress.hpp"
 #include "io/signals.hpp"
@@ -11,7 +12,9 @@
 
 #include <Teuchos_DefaultMpiComm.hpp>
 
+#include <cmath>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 
 namespace cfdmpm {
@@ -62,6 +65,15 @@ std::vector<std::string> conservedColumns(const Scene& scene)
   return columns;
 }
 
+/// What the time loop needs of the physics of a run: its diagnostics columns and their values, the
+/// time-step limit, and one step.
+struct Physics {
+  std::vector<std::string> columns;
+  std::function<std::vector<CsvValue>()> diagnostics;
+  std::function<TimeStepLimit(double previous_dt)> limit;
+  std::function<void(double dt)> advance;
+};
+
 template <int Dim>
 RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP<const Teuchos::Comm<int>>& comm)
 {
@@ -79,18 +91,55 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
               << grid.patchCount() << " patches on " << comm->getSize() << " rank(s)\n";
 
   // 2. The initial state from the scene's regions and the materials' equations of state, and the
-  //    fluid solver (its settings are checked here, before any output). Solid materials need the
-  //    particle solver, which this version does not couple yet: such scenes stop after step 0.
+  //    solvers (their settings are checked here, before any output). Fluids run the ICE step, solids
+  //    the MPM step; a scene with both needs the coupled step, which this version does not have yet:
+  //    it stops after step 0. With `ice.enabled: false` the fluids are an inert background (a dry
+  //    scene for the particle solver alone).
   CellState<Dim> state(layout, int(scene.materials.size()));
   setInitialState(scene, densityFunctions(scene), state);
-  bool fluids_only = true;
-  for (const auto& m : scene.materials) fluids_only = fluids_only && m.kind == "fluid";
+  bool has_solids = false;
+  for (const auto& m : scene.materials) has_solids = has_solids || m.kind == "solid";
+  const bool fluids_move = IceSettings::fromScene(scene).enabled;
   std::unique_ptr<IceSolver<Dim>> ice;
-  if (fluids_only) {
+  std::unique_ptr<mpm::MpmSolver<Dim>> particles;
+  IceStepReport ice_report;
+  Physics physics;
+  if (fluids_move && !has_solids) {
     ice = std::make_unique<IceSolver<Dim>>(scene, layout);
     const int failures = ice->equilibrate(state);
     if (failures > 0)
       throw std::runtime_error("initial equilibration pressure failed in " + std::to_string(failures) + " cells");
+    physics.columns = {"outer_iterations", "pressure_iterations", "outer_residual", "max_outflux_fraction"};
+    for (const std::string& c : conservedColumns<Dim>(scene)) physics.columns.push_back(c);
+    physics.diagnostics = [&] {
+      std::vector<CsvValue> row{ice_report.outer_iterations, ice_report.linear_iterations, ice_report.outer_residual,
+                                ice_report.max_outflux_fraction};
+      for (double q : conservedQuantities(state)) row.emplace_back(q);
+      return row;
+    };
+    physics.limit = [&](double previous) { return ice->stableTimeStep(state, previous); };
+    physics.advance = [&](double dt) { ice_report = ice->step(state, dt); };
+  } else if (!fluids_move && has_solids) {
+    particles = std::make_unique<mpm::MpmSolver<Dim>>(scene, layout);
+    physics.columns = {"particles"};
+    for (const auto& m : scene.materials)
+      if (m.kind == "solid") physics.columns.push_back("mass_" + m.name);
+    for (int d = 0; d < Dim; ++d) physics.columns.push_back(std::string("momentum_") + "xyz"[d] + "_particles");
+    physics.columns.push_back("kinetic_energy_particles");
+    physics.diagnostics = [&] {
+      std::vector<CsvValue> row{particles->particleCount()};
+      for (double m : particles->materialMasses()) row.emplace_back(m);
+      const auto p = particles->momentum();
+      for (int d = 0; d < Dim; ++d) row.emplace_back(p[d]);
+      row.emplace_back(particles->kineticEnergy());
+      return row;
+    };
+    physics.limit = [&](double) {
+      const mpm::MpmTimeStep mpm_limit = particles->stableTimeStep();
+      if (!(mpm_limit.dt < scene.time.dt_max)) return TimeStepLimit{scene.time.dt_max, "dt_max"};
+      return TimeStepLimit{mpm_limit.dt, "wave_speed(" + mpm_limit.material + ")"};
+    };
+    physics.advance = [&](double dt) { particles->step(dt); };
   }
 
   // 3. Output: the directory (refused if it holds an earlier run, unless overwrite), the fields of
@@ -99,15 +148,20 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
   prepareOutputDirectory(mpi, scene.output.directory, options.overwrite || scene.output.overwrite);
   const std::string run_name = std::filesystem::path(scene.path).stem().string();
   StateOutput<Dim> output(scene, *layout, run_name);
-  std::vector<std::string> columns{"step", "time", "dt", "dt_limiter", "outer_iterations",
-                                   "pressure_iterations", "outer_residual", "max_outflux_fraction"};
-  for (const std::string& c : conservedColumns<Dim>(scene)) columns.push_back(c);
+  std::vector<std::string> columns{"step", "time", "dt", "dt_limiter"};
+  if (physics.advance)
+    columns.insert(columns.end(), physics.columns.begin(), physics.columns.end());
+  else
+    for (const std::string& c : conservedColumns<Dim>(scene)) columns.push_back(c);
   const std::string csv_path = scene.output.directory + "/" + run_name + ".csv";
   CsvTimeSeries diagnostics(mpi, csv_path, columns);
-  auto report = [&](long long step, double time, double dt, const std::string& limiter, const IceStepReport& r) {
-    std::vector<CsvValue> row{step, time, dt, limiter, r.outer_iterations, r.linear_iterations, r.outer_residual,
-                              r.max_outflux_fraction};
-    for (double q : conservedQuantities(state)) row.emplace_back(q);
+  auto report = [&](long long step, double time, double dt, const std::string& limiter) {
+    std::vector<CsvValue> row{step, time, dt, limiter};
+    if (physics.advance) {
+      for (CsvValue& v : physics.diagnostics()) row.push_back(v);
+    } else {
+      for (double q : conservedQuantities(state)) row.emplace_back(q);
+    }
     diagnostics.append(row);
   };
 
@@ -115,14 +169,20 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
   RunSummary summary;
   summary.output_directory = scene.output.directory;
   summary.diagnostics = csv_path;
-  const std::string first = output.write(0, 0.0, state);
-  report(0, 0.0, 0.0, "initial", IceStepReport{});
+  auto writeOutput = [&](long long step, double time) {
+    if (!particles) return output.write(step, time, state);
+    const mpm::ParticleOutput out = particles->output();
+    return output.write(step, time, state, &out);
+  };
+  const std::string first = writeOutput(0, 0.0);
+  report(0, 0.0, 0.0, "initial");
   if (root) std::cout << "  wrote initial state: " << first << "\n";
   summary.time_series = output.seriesPath();
-  if (!ice) {
+  if (!physics.advance) {
     if (root)
-      std::cout << "  the scene has solid materials; the particle solver is not coupled in this version: "
-                   "stopping after the initial state\n";
+      std::cout << (has_solids ? "  the scene has fluids and solids; the coupled step is not in this version "
+                                 "(set ice.enabled: false to run the solids alone): stopping after the initial state\n"
+                               : "  ice.enabled is false and the scene has no solids: nothing moves; stopping\n");
     return summary;
   }
 
@@ -135,22 +195,22 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
   ProgressReporter progress(mpi, 0.0, end, scene.output.progress_interval);
   const double eps = 1e-12 * end;
   while (t < end - eps && (scene.time.max_steps < 0 || step < scene.time.max_steps)) {
-    TimeStepLimit limit = step == 0 ? TimeStepLimit{scene.time.dt_initial, "dt_initial"}
-                                    : ice->stableTimeStep(state, dt_previous);
+    TimeStepLimit limit = physics.limit(dt_previous);
+    if (step == 0 && scene.time.dt_initial < limit.dt) limit = {scene.time.dt_initial, "dt_initial"};
     dt_previous = limit.dt;
     double dt = limit.dt;
     if (t + dt > next_output - eps) {
       dt = next_output - t;
       limit.limiter += "+output";
     }
-    const IceStepReport r = ice->step(state, dt);
+    physics.advance(dt);
     t = (t + dt > next_output - eps) ? next_output : t + dt;
     ++step;
-    report(step, t, dt, limit.limiter, r);
+    report(step, t, dt, limit.limiter);
     const bool stop = stopRequested(mpi);
     const bool last = t >= end - eps || stop || (scene.time.max_steps >= 0 && step >= scene.time.max_steps);
     if (t >= next_output - eps || last) {
-      output.write(step, t, state);
+      writeOutput(step, t);
       next_output = std::min(end, next_output + (interval > 0 ? interval : end));
     }
     progress.update(step, t, dt, last);

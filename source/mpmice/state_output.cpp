@@ -34,11 +34,13 @@ template <int Dim>
 void StateOutput<Dim>::checkFields(const Scene& scene)
 {
   static const std::vector<std::string> written{"volume_fraction", "density", "velocity", "temperature",
-                                                "pressure", "specific_volume"};
+                                                "pressure", "specific_volume", "particle_velocity",
+                                                "particle_stress", "plastic_strain", "particle_material"};
   for (const std::string& f : scene.output.fields)
     if (std::find(written.begin(), written.end(), f) == written.end())
       throw InputError("cfdmpm.output.fields: got '" + f + "'; this version writes volume_fraction, density, "
-                       "velocity, temperature, pressure, specific_volume");
+                       "velocity, temperature, pressure, specific_volume, particle_velocity, particle_stress, "
+                       "plastic_strain, particle_material");
 }
 
 template <int Dim>
@@ -69,7 +71,8 @@ void StateOutput<Dim>::writeColumns(const Field<Dim>& field, int first_column, i
 }
 
 template <int Dim>
-std::string StateOutput<Dim>::write(long long step, double time, const CellState<Dim>& state)
+std::string StateOutput<Dim>::write(long long step, double time, const CellState<Dim>& state,
+                                    const mpm::ParticleOutput* particles)
 {
   auto wanted = [&](const char* name) { return std::find(fields_.begin(), fields_.end(), name) != fields_.end(); };
   hdf5_->beginStep(step, time);
@@ -81,6 +84,18 @@ std::string StateOutput<Dim>::write(long long step, double time, const CellState
     if (wanted("specific_volume")) writeColumns(state.specific_volume, m, 1, prefix + "specific_volume");
     if (wanted("temperature")) writeColumns(state.temperature, m, 1, prefix + "temperature");
     if (wanted("velocity")) writeColumns(state.velocity, CellState<Dim>::velocityColumn(m, 0), Dim, prefix + "velocity");
+  }
+  if (particles) {
+    // Positions always (the particles' geometry), then the particle fields asked for.
+    const std::size_t n = particles->count;
+    hdf5_->writeParticleVector("position", particles->position.data(), n, Dim);
+    if (wanted("particle_velocity")) hdf5_->writeParticleVector("velocity", particles->velocity.data(), n, Dim);
+    if (wanted("particle_stress")) hdf5_->writeParticleVector("stress", particles->stress.data(), n, 9);
+    if (wanted("plastic_strain")) hdf5_->writeParticleScalar("plastic_strain", particles->plastic_strain.data(), n);
+    if (wanted("particle_material")) {
+      buffer_.assign(particles->material.begin(), particles->material.end());
+      hdf5_->writeParticleScalar("material", buffer_.data(), n);
+    }
   }
   const WrittenStep written = hdf5_->endStep();
   xdmf_->addStep(written);

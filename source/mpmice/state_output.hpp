@@ -4,6 +4,7 @@
 #include "input/scene.hpp"
 #include "io/hdf5_writer.hpp"
 #include "io/xdmf_writer.hpp"
+#include "mpm/mpm_solver.hpp"
 #include "mpmice/cell_state.hpp"
 
 #include <memory>
@@ -22,8 +23,10 @@ class StateOutput {
   /// The output directory must have been prepared (prepareOutputDirectory).
   StateOutput(const Scene& scene, const Layout<Dim>& layout, const std::string& run_name);
 
-  /// Writes the fields listed in output.fields; returns the HDF5 file's path.
-  std::string write(long long step, double time, const CellState<Dim>& state);
+  /// Writes the fields listed in output.fields (cell fields from the state; particle fields, with
+  /// the positions, from `particles` when given); returns the HDF5 file's path.
+  std::string write(long long step, double time, const CellState<Dim>& state,
+                    const mpm::ParticleOutput* particles = nullptr);
 
   std::string seriesPath() const { return xdmf_->seriesPath(); }
 

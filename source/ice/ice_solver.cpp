@@ -46,21 +46,28 @@ IceSettings IceSettings::fromScene(const Scene& scene)
   IceSettings s;
   const Teuchos::ParameterList& ice = scene.parameters->isSublist("ice") ? scene.parameters->sublist("ice")
                                                                         : Teuchos::ParameterList();
-  static const char* known[] = {"enabled", "pressure", "exchange_coefficient", "max_outer_iterations", "outer_tolerance",
+  static const char* known[] = {"enabled", "isothermal", "heat_exchange_coefficient", "pressure", "exchange_coefficient", "max_outer_iterations", "outer_tolerance",
                                 "solver_tolerance", "dt_growth", "linear_solver"};
   for (auto it = ice.begin(); it != ice.end(); ++it) {
     const std::string& key = ice.name(it);
     bool ok = false;
     for (const char* k : known) ok = ok || key == k;
     if (!ok)
-      throw InputError("cfdmpm.ice." + key + ": unknown key; allowed keys in cfdmpm.ice: enabled, pressure, "
+      throw InputError("cfdmpm.ice." + key + ": unknown key; allowed keys in cfdmpm.ice: enabled, isothermal, "
+                       "heat_exchange_coefficient, pressure, "
                        "exchange_coefficient, max_outer_iterations, outer_tolerance, solver_tolerance, "
                        "dt_growth, linear_solver");
   }
-  if (ice.isParameter("enabled") && !ice.isType<bool>("enabled"))
-    throw InputError("cfdmpm.ice.enabled: got a " + ice.getEntry("enabled").getAny().typeName() +
-                     "; expected true or false");
+  for (const char* flag : {"enabled", "isothermal"})
+    if (ice.isParameter(flag) && !ice.isType<bool>(flag))
+      throw InputError(std::string("cfdmpm.ice.") + flag + ": got a " + ice.getEntry(flag).getAny().typeName() +
+                       "; expected true or false");
   s.enabled = getOr<bool>(ice, "enabled", s.enabled);
+  s.isothermal = getOr<bool>(ice, "isothermal", s.isothermal);
+  s.heat_exchange_coefficient = number(ice, "heat_exchange_coefficient", s.heat_exchange_coefficient);
+  if (!(s.heat_exchange_coefficient >= 0))
+    throw inputError("cfdmpm.ice.heat_exchange_coefficient", std::to_string(s.heat_exchange_coefficient),
+                     "must be >= 0 (W/(m^3 K))");
   s.pressure = getOr<std::string>(ice, "pressure", s.pressure);
   if (s.pressure != "implicit" && s.pressure != "explicit")
     throw inputError("cfdmpm.ice.pressure", s.pressure, "allowed: implicit, explicit");
@@ -103,7 +110,8 @@ IceSolver<Dim>::IceSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>>
       face_velocity_(layout, materials_, "face_velocity"),
       face_specific_volume_(layout, materials_, "face_specific_volume"),
       face_beta_(layout, 1, "face_beta"),
-      new_velocity_(layout, Location::Cell, materials_ * Dim, "new_velocity")
+      new_velocity_(layout, Location::Cell, materials_ * Dim, "new_velocity"),
+      old_specific_volume_(layout, Location::Cell, materials_, "old_specific_volume")
 {
   if (materials_ > ice::kMaxMaterials)
     throw InputError("cfdmpm.materials: " + std::to_string(materials_) + " materials; at most " +
@@ -115,13 +123,18 @@ IceSolver<Dim>::IceSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>>
                        "of this version runs fluid materials only");
     eos_[m] = fluidEos(material);
     viscosity_[m] = material.parameters.get<double>("viscosity");
+    specific_heat_[m] = material.parameters.get<double>("specific_heat");
+    conductivity_[m] = material.parameters.get<double>("thermal_conductivity");
     names_.push_back(material.name);
   }
   for (int d = 0; d < 3; ++d) gravity_[d] = d < Dim ? scene.domain.gravity[d] : 0.0;
-  for (int f = 0; f < 2 * Dim; ++f) wall_no_slip_[f] = 1;
+  for (int f = 0; f < 2 * Dim; ++f) wall_no_slip_[f] = 1, wall_temperature_[f] = -1;
   for (const BoundarySpec& b : scene.boundaries)
     for (int f = 0; f < 2 * Dim; ++f)
-      if (b.face == faceName(f)) wall_no_slip_[f] = b.velocity == "no_slip";
+      if (b.face == faceName(f)) {
+        wall_no_slip_[f] = b.velocity == "no_slip";
+        if (b.temperature == "fixed") wall_temperature_[f] = b.temperature_value;
+      }
   pressure_solver_ = std::make_unique<PressureSolver<Dim>>(layout, settings_.linear_solver);
   for (const char* phase : kPhases) timers_[phase] = Teuchos::TimeMonitor::getNewCounter(std::string("ice: ") + phase);
   advector_ = std::make_unique<Advector<Dim>>(layout, materials_);
@@ -432,6 +445,57 @@ void IceSolver<Dim>::cellExchange(CellState<Dim>& state, double dt)
       });
 }
 
+// Energy (when not isothermal), per material with e = c_v T: the work of the pressure on the volume
+// change, −p (v_L − v), Fourier conduction θ_m k_m ∇²T_m (fixed-temperature walls at h/2; other walls
+// insulate), then the implicit heat exchange between the materials of a cell (Uintah
+// addExch_Vel_Temp_CC, heat part). Conduction is explicit: its limit joins the time step.
+template <int Dim>
+void IceSolver<Dim>::energy(CellState<Dim>& state, const Field<Dim>& old_specific_volume, double dt)
+{
+  const int n = materials_;
+  const auto neighbours = layout_->cellNeighbours();
+  const auto theta = state.volume_fraction.view();
+  const auto rho = state.density.view();
+  const auto p = state.pressure.view();
+  const auto v = state.specific_volume.view();
+  const auto v_old = old_specific_volume.view();
+  auto T = state.temperature.view();
+  auto T_new = new_velocity_.view();  // work space: n <= n Dim columns
+  const auto cv = specific_heat_;
+  const auto k = conductivity_;
+  const auto H = ice::ExchangeCoefficients::uniform(settings_.heat_exchange_coefficient);
+  double h[3], wall_T[6];
+  for (int d = 0; d < Dim; ++d) h[d] = layout_->grid().spacing()[d];
+  for (int f = 0; f < 2 * Dim; ++f) wall_T[f] = wall_temperature_[f];
+  Kokkos::parallel_for(
+      "ice::energy", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+      KOKKOS_LAMBDA(const LocalOrdinal c) {
+        ice::MaterialArray<double> r{}, t{}, s{}, c_v{}, temperature{};
+        for (int m = 0; m < n; ++m) {
+          double conduction = 0;  // W/m^3
+          for (int d = 0; d < Dim; ++d)
+            for (int side = 0; side < 2; ++side) {
+              const int f = 2 * d + side;
+              const LocalOrdinal o = neighbours(c, f);
+              if (o >= 0)
+                conduction += k[m] * theta(c, m) * (T(o, m) - T(c, m)) / (h[d] * h[d]);
+              else if (wall_T[f] >= 0)
+                conduction += k[m] * theta(c, m) * 2.0 * (wall_T[f] - T(c, m)) / (h[d] * h[d]);
+            }
+          double Tm = T(c, m) - p(c, 0) * (v(c, m) - v_old(c, m)) / cv[m];
+          if (rho(c, m) > 0) Tm += dt * conduction / (rho(c, m) * cv[m]);
+          r[m] = rho(c, m), t[m] = theta(c, m), s[m] = v(c, m), c_v[m] = cv[m], temperature[m] = Tm;
+        }
+        ice::exchangeHeatCC(n, dt, H, r, t, s, c_v, temperature);
+        for (int m = 0; m < n; ++m) T_new(c, m) = temperature[m];
+      });
+  Kokkos::parallel_for(
+      "ice::copyTemperature", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+      KOKKOS_LAMBDA(const LocalOrdinal c) {
+        for (int m = 0; m < n; ++m) T(c, m) = T_new(c, m);
+      });
+}
+
 template <int Dim>
 IceStepReport IceSolver<Dim>::step(CellState<Dim>& state, double dt)
 {
@@ -511,14 +575,20 @@ IceStepReport IceSolver<Dim>::step(CellState<Dim>& state, double dt)
   {
     Teuchos::TimeMonitor phase(*timers_.at("momentum and exchange"));
     state.pressure.exchangeHalo();
+    if (!settings_.isothermal) {
+      Kokkos::deep_copy(old_specific_volume_.view(), state.specific_volume.view());
+      state.temperature.exchangeHalo();
+    }
     momentumAndLagrangianValues(state, dt);
     cellExchange(state, dt);
+    if (!settings_.isothermal) energy(state, old_specific_volume_, dt);
   }
 
   // [10] Advection of mass, velocity and specific volume by the corrected face velocities.
   std::optional<Teuchos::TimeMonitor> advection_phase(std::in_place, *timers_.at("advection"));
-  const AdvectionStatus advected =
-      advector_->advect(face_velocity_, dt, state.density, {&state.velocity, &state.specific_volume});
+  std::vector<Field<Dim>*> carried{&state.velocity, &state.specific_volume};
+  if (!settings_.isothermal) carried.push_back(&state.temperature);  // c_v T is the energy per mass
+  const AdvectionStatus advected = advector_->advect(face_velocity_, dt, state.density, carried);
   report.max_outflux_fraction = advected.max_outflux_fraction;
   if (!advected.ok) throw std::runtime_error("ice: " + advected.message());
 
@@ -527,8 +597,10 @@ IceStepReport IceSolver<Dim>::step(CellState<Dim>& state, double dt)
   {
     auto theta = state.volume_fraction.view();
     auto u = state.velocity.view();
+    auto T = state.temperature.view();
     const auto rho = state.density.view();
     const auto v = state.specific_volume.view();
+    const auto cv = specific_heat_;
     const int n = materials_;
     Kokkos::parallel_for(
         "ice::closeCells", Kokkos::RangePolicy<ExecutionSpace>(0, state.density.overlapCount()),
@@ -539,9 +611,13 @@ IceStepReport IceSolver<Dim>::step(CellState<Dim>& state, double dt)
             mass += rho(c, m);
             for (int d = 0; d < Dim; ++d) momentum[d] += rho(c, m) * u(c, m * Dim + d);
           }
+          double heat = 0, capacity = 0;
+          for (int m = 0; m < n; ++m) heat += rho(c, m) * cv[m] * T(c, m), capacity += rho(c, m) * cv[m];
           for (int m = 0; m < n; ++m)
-            if (!(rho(c, m) > kNegligibleMassShare * mass))
+            if (!(rho(c, m) > kNegligibleMassShare * mass)) {
               for (int d = 0; d < Dim; ++d) u(c, m * Dim + d) = momentum[d] / (mass + kTiny);
+              if (capacity > 0) T(c, m) = heat / capacity;
+            }
         });
   }
   return report;
@@ -550,8 +626,8 @@ IceStepReport IceSolver<Dim>::step(CellState<Dim>& state, double dt)
 template <int Dim>
 TimeStepLimit IceSolver<Dim>::stableTimeStep(const CellState<Dim>& state, double previous_dt) const
 {
-  // [11] Convective CFL: Δt ≤ CFL h / |u| per direction; viscous: Δt ≤ CFL h² / (2 Dim ν); both per
-  // material, over cells where the material is present (θ > 1e-6).
+  // [11] Convective CFL: Δt ≤ CFL h / |u| per direction; viscous: Δt ≤ CFL h² / (2 Dim ν); conduction
+  // likewise with the thermal diffusivity; per material, over cells where it is present (θ > 1e-6).
   const int n = materials_;
   const auto u = state.velocity.view();
   const auto theta = state.volume_fraction.view();
@@ -562,7 +638,7 @@ TimeStepLimit IceSolver<Dim>::stableTimeStep(const CellState<Dim>& state, double
     inv_h[d] = 1.0 / layout_->grid().spacing()[d];
   }
   const double cfl = scene_.time.cfl;
-  std::vector<double> local(2 * n, DBL_MAX), global(2 * n);
+  std::vector<double> local(3 * n, DBL_MAX), global(3 * n);
   for (int m = 0; m < n; ++m) {
     double rate = 0, max_nu = 0;
     Kokkos::parallel_reduce(
@@ -581,15 +657,19 @@ TimeStepLimit IceSolver<Dim>::stableTimeStep(const CellState<Dim>& state, double
           if (v(c, m) > worst) worst = v(c, m);
         },
         Kokkos::Max<double>(max_nu));
-    local[2 * m] = rate > 0 ? cfl / rate : DBL_MAX;
+    local[3 * m] = rate > 0 ? cfl / rate : DBL_MAX;
     const double nu = viscosity_[m] * max_nu;  // largest kinematic viscosity μ v
-    local[2 * m + 1] = nu > 0 ? cfl * h_min * h_min / (2.0 * Dim * nu) : DBL_MAX;
+    local[3 * m + 1] = nu > 0 ? cfl * h_min * h_min / (2.0 * Dim * nu) : DBL_MAX;
+    // Explicit conduction: thermal diffusivity k v / c_v, when the energy equation runs.
+    const double alpha = settings_.isothermal ? 0.0 : conductivity_[m] * max_nu / specific_heat_[m];
+    local[3 * m + 2] = alpha > 0 ? cfl * h_min * h_min / (2.0 * Dim * alpha) : DBL_MAX;
   }
-  Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_MIN, 2 * n, local.data(), global.data());
+  Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_MIN, 3 * n, local.data(), global.data());
   TimeStepLimit limit{scene_.time.dt_max, "dt_max"};
   for (int m = 0; m < n; ++m) {
-    if (global[2 * m] < limit.dt) limit = {global[2 * m], "convection(" + names_[m] + ")"};
-    if (global[2 * m + 1] < limit.dt) limit = {global[2 * m + 1], "viscosity(" + names_[m] + ")"};
+    if (global[3 * m] < limit.dt) limit = {global[3 * m], "convection(" + names_[m] + ")"};
+    if (global[3 * m + 1] < limit.dt) limit = {global[3 * m + 1], "viscosity(" + names_[m] + ")"};
+    if (global[3 * m + 2] < limit.dt) limit = {global[3 * m + 2], "conduction(" + names_[m] + ")"};
   }
   if (previous_dt > 0 && settings_.dt_growth * previous_dt < limit.dt)
     limit = {settings_.dt_growth * previous_dt, "growth"};

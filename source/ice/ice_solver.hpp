@@ -31,6 +31,8 @@ namespace cfdmpm {
 /// Settings of the ICE step, from the scene's `ice` section (doc/input.md).
 struct IceSettings {
   bool enabled = true;                   // false: fluids are an inert background (dry scenes)
+  bool isothermal = true;                // true: temperatures keep their values (no energy equation)
+  double heat_exchange_coefficient = 0;  // H between every pair of materials (W/(m^3 K))
   std::string pressure = "implicit";     // "implicit" or "explicit" (for comparison)
   double exchange_coefficient = 1e15;    // momentum exchange K between every pair (kg/(m^3 s))
   int max_outer_iterations = 20;
@@ -91,6 +93,7 @@ class IceSolver {
   void correctFaceVelocities(double dt);
   void momentumAndLagrangianValues(CellState<Dim>& state, double dt);
   void cellExchange(CellState<Dim>& state, double dt);
+  void energy(CellState<Dim>& state, const Field<Dim>& old_specific_volume, double dt);
 
   Scene scene_;
   IceSettings settings_;
@@ -98,6 +101,9 @@ class IceSolver {
   int materials_;
   ice::MaterialArray<ice::Eos> eos_;
   ice::MaterialArray<double> viscosity_;
+  ice::MaterialArray<double> specific_heat_;
+  ice::MaterialArray<double> conductivity_;
+  double wall_temperature_[6];  // K; < 0: zero normal gradient
   std::vector<std::string> names_;
   double gravity_[3];
   int wall_no_slip_[6];
@@ -110,6 +116,7 @@ class IceSolver {
   FaceField<Dim> face_specific_volume_; // per material, after the face exchange
   FaceField<Dim> face_beta_;            // Σ θ_f v_f
   Field<Dim> new_velocity_;             // work array of the momentum update
+  Field<Dim> old_specific_volume_;      // v before the Lagrangian update (for the p dv work)
   std::unique_ptr<PressureSolver<Dim>> pressure_solver_;
   std::unique_ptr<Advector<Dim>> advector_;
   std::map<std::string, Teuchos::RCP<Teuchos::Time>> timers_;

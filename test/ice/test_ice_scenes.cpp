@@ -239,3 +239,82 @@ TEST(IceScenes, DamBreakIsTheSameOnOneAndTwoRanks)
     EXPECT_LE(worst, 1e-10 * scale) << names[f];
   }
 }
+
+namespace {
+
+struct ConductionResult {
+  double worst_error;   // K, largest |T − exact| at t = 1 s
+  double energy_change; // relative
+};
+
+// Water at rest, 300 K left of x = 0.05 m and 280 K right of it, in a 0.1 m channel of `cells`
+// cells, no gravity, no thermal expansion (so nothing moves): the energy equation reduces to
+// ∂T/∂t = α ∂²T/∂x², α = k / (ρ c_v). With insulated walls at 0 and 0.1 m the exact solution is the
+// infinite-domain one for the initial state mirrored about the walls: hot on [−0.05, 0.05] + 0.2 k,
+// T = 280 + 10 Σ_k [erf((x − a_k)/(2 sqrt(α t))) − erf((x − b_k)/(2 sqrt(α t)))].
+// The conductivity is raised to 600 W/(m K) so that the front spreads ~12 mm in 1 s.
+ConductionResult conduct(int cells)
+{
+  const double h = 0.1 / cells;
+  const Scene scene = sceneFromYaml(R"(
+cfdmpm:
+  domain: {dimension: 2, lower: [0.0, 0.0], upper: [0.1, )" + std::to_string(2 * h) + R"(], cells: [)" +
+                                    std::to_string(cells) + R"(, 2], patch_cells: [25, 2], gravity: [0.0, 0.0]}
+  materials:
+    water:
+      kind: fluid
+      equation_of_state: {type: linear_water, bulk_modulus: 2.15e9, reference_density: 998.0, reference_pressure: 101325.0, reference_temperature: 290.0, thermal_expansion: 0.0}
+      viscosity: 1.0e-3
+      specific_heat: 4157.0
+      thermal_conductivity: 600.0
+  initial_state: {background_material: water, temperature: 280.0, pressure: 101325.0, hydrostatic: false}
+  regions:
+    hot: {material: water, shape: box, lower: [0.0, 0.0], upper: [0.05, )" + std::to_string(2 * h) + R"(], temperature: 300.0}
+  time: {end_time: 1.0, dt_max: 1.0e-3}
+  output: {directory: unused, interval: 1.0}
+  ice: {isothermal: false}
+)");
+  IceRun<2> run(scene, world());
+  auto internalEnergy = [&] {
+    const auto rho = run.state.density.view();
+    const auto T = run.state.temperature.view();
+    double local = 0;
+    for (LocalOrdinal c = 0; c < run.state.density.ownedCount(); ++c) local += rho(c, 0) * 4157.0 * T(c, 0);
+    return globalSum(*world(), local) * run.layout->grid().cellVolume();
+  };
+  const double energy0 = internalEnergy();
+  run.runUntil(1.0);
+  const double energy1 = internalEnergy();
+  const std::vector<double> T = gatherField(run.state.temperature);
+  const double alpha = 600.0 / (998.0 * 4157.0);
+  double worst = 0;
+  for (int i = 0; i < cells; ++i) {  // row j = 0: global ids 0 .. cells − 1
+    const double x = (i + 0.5) * h;
+    double exact = 280.0;
+    for (int k = -3; k <= 3; ++k)
+      exact += 10.0 * (std::erf((x + 0.05 - 0.2 * k) / (2 * std::sqrt(alpha))) -
+                       std::erf((x - 0.05 - 0.2 * k) / (2 * std::sqrt(alpha))));
+    worst = std::max(worst, std::abs(T[i] - exact));
+  }
+  if (world()->getRank() == 0)
+    std::cout << "conduction, " << cells << " cells: " << run.steps << " steps, largest error " << worst
+              << " K, energy change " << energy1 / energy0 - 1 << "\n";
+  return {worst, energy1 / energy0 - 1};
+}
+
+}  // namespace
+
+TEST(IceScenes, HeatConductsLikeTheDiffusionEquation)
+{
+  const ConductionResult coarse = conduct(100), fine = conduct(200);
+  // Conservative fluxes (one material, θ = 1): internal energy changes by round-off only.
+  EXPECT_LT(std::abs(coarse.energy_change), 1e-13);
+  EXPECT_LT(std::abs(fine.energy_change), 1e-13);
+  // Error bound. The scheme's truncation error is (α Δt/2 − h²/12) α ∂⁴T/∂x⁴; on the spreading erf
+  // profile ∂⁴T/∂x⁴ ~ ΔT/(4 α t)², and integrated from the moment the jump is one cell wide
+  // (t0 = h²/(4α)) it gives |error| ≲ ΔT |α Δt/(2 h²) − 1/12| / 4 = 20 K × 0.052 / 4 = 0.26 K at the
+  // CFL 0.25 the run uses (α Δt/h² = 1/16). Both terms scale with h² at fixed CFL: halving h must
+  // at least halve the error (second order would quarter it).
+  EXPECT_LT(coarse.worst_error, 0.26);
+  EXPECT_LT(fine.worst_error, 0.5 * coarse.worst_error);
+}

@@ -33,7 +33,7 @@ it does nothing. The configuration, the versions and the time of each stage are 
 
 Options (environment variable in brackets):
   --prefix DIR       install prefix            [TRILINOS_OPENMP_PREFIX, default <work>/install]
-  --work-dir DIR     work directory            [TRILINOS_OPENMP_WORK,   default /work/trilinos-openmp]
+  --work-dir DIR     work directory            [TRILINOS_OPENMP_WORK,   default trilinos-openmp beside the project]
   --src-dir DIR      source download directory [TRILINOS_OPENMP_SRC,    default <work>/src]
   --build-dir DIR    build directory (kept)    [TRILINOS_OPENMP_BUILD,  default <work>/build]
   --jobs N           parallel compile jobs     [TRILINOS_OPENMP_JOBS,   default nproc = $(nproc)]
@@ -51,7 +51,8 @@ EOF
 }
 
 # --- Options --------------------------------------------------------------------------------------
-work_dir=${TRILINOS_OPENMP_WORK:-/work/trilinos-openmp}
+project_root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+work_dir=${TRILINOS_OPENMP_WORK:-$(dirname "$project_root")/trilinos-openmp}
 prefix=${TRILINOS_OPENMP_PREFIX:-}
 src_dir=${TRILINOS_OPENMP_SRC:-}
 build_dir=${TRILINOS_OPENMP_BUILD:-}

@@ -6,12 +6,12 @@
 //   [4]  face velocities (density-weighted average, pressure gradient, gravity), face exchange
 //   [5]  implicit pressure correction δp (Belos CG + MueLu) with outer iterations; faces corrected
 //   [6]  face pressure; momentum sources (pressure force by volume fraction, viscosity, gravity)
-//   [8]  Lagrangian values; implicit cell-centred momentum exchange
+//   [8]  Lagrangian values; implicit cell-centred momentum exchange; energy (unless isothermal)
 //   [10] conservative second-order advection
-//   [11] next Δt from convective CFL and viscosity
+//   [11] next Δt from convective CFL, viscosity and conduction
 //
 // The state is the shared CellState, so solid (MPM) materials can join the same equilibration,
-// pressure and exchange later. This version is isothermal: temperatures stay as given.
+// pressure and exchange later. Isothermal by default (IceSettings::isothermal).
 #include "ice/advection.hpp"
 #include "ice/eos.hpp"
 #include "ice/face_field.hpp"

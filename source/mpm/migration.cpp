@@ -1,6 +1,6 @@
 #include "mpm/migration.hpp"
 
-#include <Teuchos_DefaultMpiComm.hpp>
+#include "common/mpi_comm.hpp"
 
 #include <sstream>
 #include <stdexcept>
@@ -22,7 +22,7 @@ void ensureSize(View& view, int n, const char* label)
 
 template <int Dim>
 ParticleMigration<Dim>::ParticleMigration(const Layout<Dim>& layout)
-    : comm_(*Teuchos::rcp_dynamic_cast<const Teuchos::MpiComm<int>>(layout.comm(), true)->getRawMpiComm()),
+    : comm_(rawMpiComm(layout.comm())),
       rank_(layout.comm()->getRank()),
       ranks_(layout.comm()->getSize()),
       owned_cells_(layout.ownedCells()),

@@ -1,5 +1,6 @@
 #include "mpm/mpm_solver.hpp"
 
+#include "common/mpi_comm.hpp"
 #include "mpm/shape_functions.hpp"
 
 #include <Teuchos_CommHelpers.hpp>
@@ -74,11 +75,6 @@ KOKKOS_INLINE_FUNCTION void frictionalContact(double v[Dim], const double v_ref[
   // Tangential reduction min(mu dv_n, |dv_t|): sticking when the friction cone holds it.
   const double scale = tangent_norm > 0.0 ? math::min(mu * normal, tangent_norm) / tangent_norm : 0.0;
   for (int d = 0; d < Dim; ++d) v[d] -= normal * n[d] + scale * tangent[d];
-}
-
-MPI_Comm rawComm(const Teuchos::RCP<const Teuchos::Comm<int>>& comm)
-{
-  return *Teuchos::rcp_dynamic_cast<const Teuchos::MpiComm<int>>(comm, true)->getRawMpiComm();
 }
 
 }  // namespace
@@ -538,7 +534,7 @@ MpmTimeStep MpmSolver<Dim>::stableTimeStep() const
     double value;
     int rank;
   } local{fastest_value, layout_->comm()->getRank()}, global{};
-  const MPI_Comm comm = rawComm(layout_->comm());
+  const MPI_Comm comm = rawMpiComm(layout_->comm());
   MPI_Allreduce(&local, &global, 1, MPI_DOUBLE_INT, MPI_MAXLOC, comm);
   double info[3] = {0.0, 0.0, -1.0};  // wave speed, speed, material
   if (global.rank == layout_->comm()->getRank() && fastest_particle >= 0) {

@@ -1,5 +1,6 @@
 #include "mpmice/simulation.hpp"
 
+#include "common/mpi_comm.hpp"
 #include "ice/ice_solver.hpp"
 #include "ice/material_eos.hpp"
 #include "mpm/mpm_solver.hpp"
@@ -10,8 +11,6 @@
 #include "mpmice/initial_state.hpp"
 #include "mpmice/state_output.hpp"
 
-#include <Teuchos_DefaultMpiComm.hpp>
-
 #include <cmath>
 #include <filesystem>
 #include <functional>
@@ -20,11 +19,6 @@
 namespace cfdmpm {
 
 namespace {
-
-MPI_Comm rawComm(const Teuchos::RCP<const Teuchos::Comm<int>>& comm)
-{
-  return *Teuchos::rcp_dynamic_cast<const Teuchos::MpiComm<int>>(comm, true)->getRawMpiComm();
-}
 
 /// Conserved quantities per material over the whole domain (per metre of depth in 2-D): mass (kg),
 /// momentum components (kg m/s) and kinetic energy (J), in the order of conservedColumns().
@@ -78,7 +72,7 @@ template <int Dim>
 RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP<const Teuchos::Comm<int>>& comm)
 {
   const bool root = comm->getRank() == 0;
-  const MPI_Comm mpi = rawComm(comm);
+  const MPI_Comm mpi = rawMpiComm(comm);
 
   // 1. Grid, decomposition of its patches with METIS, and this rank's share.
   const Grid<Dim> grid(scene.domain);

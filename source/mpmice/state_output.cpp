@@ -1,18 +1,12 @@
 #include "mpmice/state_output.hpp"
 
-#include <Teuchos_DefaultMpiComm.hpp>
+#include "common/mpi_comm.hpp"
 
 #include <algorithm>
 
 namespace cfdmpm {
 
 namespace {
-
-MPI_Comm rawComm(const Teuchos::RCP<const Teuchos::Comm<int>>& comm)
-{
-  const auto mpi = Teuchos::rcp_dynamic_cast<const Teuchos::MpiComm<int>>(comm, true);
-  return *mpi->getRawMpiComm();
-}
 
 template <int Dim>
 OutputLayout outputLayout(const Grid<Dim>& grid, Location location, const std::vector<Box>& boxes)
@@ -48,7 +42,7 @@ StateOutput<Dim>::StateOutput(const Scene& scene, const Layout<Dim>& layout, con
     : fields_(scene.output.fields), directory_(scene.output.directory)
 {
   for (const auto& m : scene.materials) material_names_.push_back(m.name);
-  const MPI_Comm comm = rawComm(layout.comm());
+  const MPI_Comm comm = rawMpiComm(layout.comm());
   const OutputLayout cells = outputLayout(layout.grid(), Location::Cell, layout.ownedCellBoxes());
   const OutputLayout nodes = outputLayout(layout.grid(), Location::Node, layout.ownedNodeBoxes());
   hdf5_ = std::make_unique<Hdf5Writer>(comm, directory_, run_name, cells, nodes);

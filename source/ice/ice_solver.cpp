@@ -24,6 +24,24 @@ constexpr double kNegligibleMassShare = 1e-12;
 // velocity of its own (a denormal volume fraction would leave it uncoupled by the exchange).
 constexpr double kNegligibleVolumeShare = 1e-12;
 
+// Gives every material of cell c that holds a negligible share of its mass the mixture's
+// (mass-weighted) velocity, so that its meaningless own value can neither limit the time step nor
+// leak into advection when it arrives. Returns the cell's mass density.
+template <int Dim, class DensityView, class VelocityView>
+KOKKOS_INLINE_FUNCTION double followMixtureVelocity(int n, LocalOrdinal c, const DensityView& rho,
+                                                    const VelocityView& u)
+{
+  double mass = 0, momentum[3] = {0, 0, 0};
+  for (int m = 0; m < n; ++m) {
+    mass += rho(c, m);
+    for (int d = 0; d < Dim; ++d) momentum[d] += rho(c, m) * u(c, m * Dim + d);
+  }
+  for (int m = 0; m < n; ++m)
+    if (!(rho(c, m) > kNegligibleMassShare * mass))
+      for (int d = 0; d < Dim; ++d) u(c, m * Dim + d) = momentum[d] / (mass + kTiny);
+  return mass;
+}
+
 template <class T>
 T getOr(const Teuchos::ParameterList& list, const std::string& key, T fallback)
 {
@@ -432,16 +450,9 @@ void IceSolver<Dim>::cellExchange(CellState<Dim>& state, double dt)
           for (int d = 0; d < Dim; ++d) vel[m][d] = u(c, m * Dim + d);
         }
         ice::exchangeMomentumCC<Dim>(n, dt, K, r, t, s, vel);
-        // A material without mass in the cell takes the mixture's velocity, so that its (meaningless)
-        // own value can neither limit the time step nor leak into advection when it arrives.
-        double mass = 0, momentum[3] = {0, 0, 0};
-        for (int m = 0; m < n; ++m) {
-          mass += r[m];
-          for (int d = 0; d < Dim; ++d) momentum[d] += r[m] * vel[m][d];
-        }
         for (int m = 0; m < n; ++m)
-          for (int d = 0; d < Dim; ++d)
-            u(c, m * Dim + d) = r[m] > kNegligibleMassShare * mass ? vel[m][d] : momentum[d] / (mass + kTiny);
+          for (int d = 0; d < Dim; ++d) u(c, m * Dim + d) = vel[m][d];
+        followMixtureVelocity<Dim>(n, c, rho, u);
       });
 }
 
@@ -593,7 +604,7 @@ IceStepReport IceSolver<Dim>::step(CellState<Dim>& state, double dt)
   if (!advected.ok) throw std::runtime_error("ice: " + advected.message());
 
   // Closure: θ = ρ v (the next equilibration restores Σθ = 1); a material without mass in a cell
-  // takes the mixture's velocity there (advection leaves its own value undefined).
+  // takes the mixture's velocity and temperature there (advection leaves its own values undefined).
   {
     auto theta = state.volume_fraction.view();
     auto u = state.velocity.view();
@@ -605,19 +616,13 @@ IceStepReport IceSolver<Dim>::step(CellState<Dim>& state, double dt)
     Kokkos::parallel_for(
         "ice::closeCells", Kokkos::RangePolicy<ExecutionSpace>(0, state.density.overlapCount()),
         KOKKOS_LAMBDA(const LocalOrdinal c) {
-          double mass = 0, momentum[3] = {0, 0, 0};
-          for (int m = 0; m < n; ++m) {
-            theta(c, m) = rho(c, m) * v(c, m);
-            mass += rho(c, m);
-            for (int d = 0; d < Dim; ++d) momentum[d] += rho(c, m) * u(c, m * Dim + d);
-          }
+          for (int m = 0; m < n; ++m) theta(c, m) = rho(c, m) * v(c, m);
+          const double mass = followMixtureVelocity<Dim>(n, c, rho, u);
           double heat = 0, capacity = 0;
           for (int m = 0; m < n; ++m) heat += rho(c, m) * cv[m] * T(c, m), capacity += rho(c, m) * cv[m];
-          for (int m = 0; m < n; ++m)
-            if (!(rho(c, m) > kNegligibleMassShare * mass)) {
-              for (int d = 0; d < Dim; ++d) u(c, m * Dim + d) = momentum[d] / (mass + kTiny);
-              if (capacity > 0) T(c, m) = heat / capacity;
-            }
+          if (capacity > 0)
+            for (int m = 0; m < n; ++m)
+              if (!(rho(c, m) > kNegligibleMassShare * mass)) T(c, m) = heat / capacity;
         });
   }
   return report;

@@ -111,19 +111,16 @@ def main():
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
-        fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
-        ax1.plot(T_sim, Z_sim, "-", label="cfdmpm")
-        ax1.plot(surge[:, 0], surge[:, 1], "o", label="Martin & Moyce (1952)")
-        ax1.set_xlabel("T = t sqrt(2g/a)")
-        ax1.set_ylabel("Z = x_front / a")
-        ax1.set_title("surge front (RMS %.1f %%)" % (100 * z_err["rms"]))
-        ax1.legend()
-        ax2.plot(tau_sim, H_sim, "-", label="cfdmpm")
-        ax2.plot(column[:, 0], column[:, 1], "o", label="Martin & Moyce (1952)")
-        ax2.set_xlabel("tau = t sqrt(g/a)")
-        ax2.set_ylabel("H = h / (2a)")
-        ax2.set_title("residual column (RMS %.1f %%)" % (100 * h_err["rms"]))
-        ax2.legend()
+        fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+        panels = [(T_sim, Z_sim, surge, "T = t sqrt(2g/a)", "Z = x_front / a", "surge front", z_err),
+                  (tau_sim, H_sim, column, "tau = t sqrt(g/a)", "H = h / (2a)", "residual column", h_err)]
+        for ax, (t_s, q_s, data, xlabel, ylabel, title, err) in zip(axes, panels):
+            ax.plot(t_s, q_s, "-", label="cfdmpm")
+            ax.plot(data[:, 0], data[:, 1], "o", label="Martin & Moyce (1952)")
+            ax.set_xlabel(xlabel)
+            ax.set_ylabel(ylabel)
+            ax.set_title("%s (RMS %.1f %%, no time shift)" % (title, 100 * err["rms"]))
+            ax.legend()
         fig.tight_layout()
         fig.savefig(args.png, dpi=100)
         print("plot: " + args.png)

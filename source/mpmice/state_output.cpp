@@ -80,9 +80,12 @@ std::string StateOutput<Dim>::write(long long step, double time, const CellState
     if (wanted("velocity")) writeColumns(state.velocity, CellState<Dim>::velocityColumn(m, 0), Dim, prefix + "velocity");
   }
   if (particles) {
-    // Positions always (the particles' geometry), then the particle fields asked for.
+    // Positions and ids always (the particles' geometry, and what follows a particle from step to
+    // step and across rank counts), then the particle fields asked for.
     const std::size_t n = particles->count;
     hdf5_->writeParticleVector("position", particles->position.data(), n, Dim);
+    buffer_.assign(particles->id.begin(), particles->id.end());  // exact as float64 below 2^53
+    hdf5_->writeParticleScalar("id", buffer_.data(), n);
     if (wanted("particle_velocity")) hdf5_->writeParticleVector("velocity", particles->velocity.data(), n, Dim);
     if (wanted("particle_stress")) hdf5_->writeParticleVector("stress", particles->stress.data(), n, 9);
     if (wanted("plastic_strain")) hdf5_->writeParticleScalar("plastic_strain", particles->plastic_strain.data(), n);

@@ -43,6 +43,11 @@ for path in steps:
         inside = np.all((p[:, 0] >= 0) & (p[:, 0] <= 0.4) & (p[:, 1] >= 0) & (p[:, 1] <= 0.15))
         check(inside, "%s: every particle inside the box" % os.path.basename(path))
         check(f["particles/stress"].shape == (int(expected), 9), "stress has 9 components")
+        ids = f["particles/id"][...]
+        check(np.unique(ids).size == int(expected), "%s: every particle id written once" % os.path.basename(path))
+        if path == steps[0]:
+            first_ids = np.sort(ids)
+        check(np.array_equal(np.sort(ids), first_ids), "%s: the same particle ids as step 0" % os.path.basename(path))
         centre.append(p[:, 1].mean())
 # The column collapses: its centre of mass falls, from 0.05 m, and cannot rise (dissipative flow).
 check(abs(centre[0] - 0.05) < 1e-12, "initial centre of mass at 0.05 m (%.6f)" % centre[0])

@@ -33,7 +33,7 @@ packages=(
   libtrilinos-stratimikos-dev libtrilinos-teko-dev libtrilinos-teuchos-dev libtrilinos-thyra-dev
   libtrilinos-tpetra-dev libtrilinos-trilinosss-dev libtrilinos-triutils-dev libtrilinos-xpetra-dev
   libtrilinos-zoltan-dev libtrilinos-zoltan2-dev
-  python3 python3-numpy python3-matplotlib python3-h5py
+  python3 python3-numpy python3-matplotlib python3-h5py python3-yaml
 )
 
 if [ "$install" = 1 ]; then

@@ -149,7 +149,10 @@ RCP<ParameterList> parseYaml(const std::string& path)
   try {
     return Teuchos::getParametersFromYamlFile(path);
   } catch (const Teuchos::ParserFail& error) {
-    throw InputError(path + ": YAML syntax error: " + cleanTeuchosMessage(error.what()));
+    // Teuchos' parser reads a subset of YAML; two common forms it rejects get a hint.
+    throw InputError(path + ": YAML syntax error: " + cleanTeuchosMessage(error.what()) +
+                     "\n(note: write a list as [a, b] on one line, or as '- a' items indented deeper than their "
+                     "key; a [...] or {...} must not break across lines)");
   } catch (const std::exception& error) {
     throw InputError(path + ": cannot be read as a scene: " + cleanTeuchosMessage(error.what()));
   }

@@ -32,7 +32,7 @@ TEST_F(SceneTest, YamlSyntaxErrorKeepsLineAndColumn)
 {
   // An unclosed flow list on line 10 of the file.
   const std::string message = errorOf(replaced(kFullScene, "cells: [20, 10]", "cells: [20, 10"));
-  expectMentions(message, {"scene.yaml", "YAML syntax error", "line", "column"});
+  expectMentions(message, {"scene.yaml", "YAML syntax error", "line", "column", "on one line"});
   EXPECT_EQ(message.find("Throw number"), std::string::npos) << message;
 }
 

@@ -3,8 +3,9 @@
 // block settling under gravity), per phase, against a memory-bound reference kernel timed in the
 // same run (a triad over 10 doubles per particle).
 //
-// usage: [mpiexec -n N] bench_mpm [cells_x [steps]]     (defaults 1000 10; the block fills half the
-//        width and the whole height of a 2:1 domain: cells_x^2 / 4 cells of it, 4 particles each)
+// usage: [mpiexec -n N] bench_mpm [cells_x [steps [usl|musl]]]   (defaults 1000 10 and the solver's
+//        default order; the block fills half the width and the whole height of a 2:1 domain:
+//        cells_x^2 / 4 cells of it, 4 particles each)
 #include "grid/geometry.hpp"
 #include "mpm/mpm_solver.hpp"
 #include "mpm_scene_builder.hpp"
@@ -16,6 +17,7 @@
 #include <chrono>
 #include <iomanip>
 #include <iostream>
+#include <string>
 
 using namespace cfdmpm;
 
@@ -34,6 +36,8 @@ int main(int argc, char** argv)
     const long long nx = argc > 1 ? std::atoll(argv[1]) : 1000;
     const int steps = argc > 2 ? std::atoi(argv[2]) : 10;
     const long long ny = nx / 2;
+    mpm::MpmOptions options;
+    if (argc > 3) options.stress_update = std::string(argv[3]) == "usl" ? mpm::StressUpdate::Last : mpm::StressUpdate::ModifiedLast;
     Scene scene = mpm::scenes::dryScene<2>({0, 0, 0}, {1.0, 0.5, 0}, {nx, ny, 1}, {64, 64, 1}, {0, -9.81, 0});
     mpm::scenes::addLinearElastic(scene, "block", 2000.0, 1.0e7, 0.3, 2);
     mpm::scenes::addBox(scene, "block", {0.0, 0.0, 0}, {0.5, 0.5, 0});
@@ -50,7 +54,7 @@ int main(int argc, char** argv)
     }
     const auto layout =
         std::make_shared<const Layout<2>>(grid, partitionPatches(grid, comm->getSize(), weight), 1, comm);
-    mpm::MpmSolver<2> solver(scene, layout);
+    mpm::MpmSolver<2> solver(scene, layout, options);
     const double dt = solver.stableTimeStep().dt;
     for (int s = 0; s < 2; ++s) solver.step(dt);  // warm-up
 
@@ -79,7 +83,8 @@ int main(int argc, char** argv)
     const double triad = bench::triadSeconds(std::size_t(particles / ranks) * 10);
     if (root) {
       std::cout << std::fixed << std::setprecision(3) << "MPM step, " << particles << " particles, " << nx << " x "
-                << ny << " cells, " << ranks << " rank(s), " << steps << " steps\n"
+                << ny << " cells, " << ranks << " rank(s), " << steps << " steps, "
+                << (options.stress_update == mpm::StressUpdate::Last ? "USL" : "MUSL") << "\n"
                 << "particle-steps per second per core: " << std::scientific << std::setprecision(3)
                 << double(particles) * steps / total / ranks << std::fixed << "\n"
                 << "whole step: " << 1e6 * total / (double(particles) * steps) * ranks << " core-us per particle-step, "

@@ -77,6 +77,101 @@ KOKKOS_INLINE_FUNCTION void frictionalContact(double v[Dim], const double v_ref[
   for (int d = 0; d < Dim; ++d) v[d] -= normal * n[d] + scale * tangent[d];
 }
 
+/// What a node velocity must satisfy after the grid update: contact between materials
+/// (Bardenhagen et al. 2001) where two or more have mass, then the walls of the domain. Applied to
+/// v* by integrateGrid and, in the MUSL order, again to the re-mapped velocity.
+template <int Dim>
+struct GridConditions {
+  int materials = 0;
+  NodeColumns col;
+  MaterialTable table;
+  double empty = 0.0;  // node mass below which a material is absent (kg)
+  bool contact = false;
+  double mu_contact = 0.0, mu_wall = 0.0;
+  int no_slip[2 * Dim] = {};
+  long long last_node[Dim] = {};
+  typename Layout<Dim>::IjkTable ijk;
+
+  template <class Sums>
+  KOKKOS_INLINE_FUNCTION void apply(int i, const Sums& sums, const double m[], double v[][Dim]) const
+  {
+    // Contact where two or more materials meet: each approaching material loses its normal
+    // velocity relative to the centre of mass (a rigid material's velocity when one is there).
+    // Only v* is corrected: the FLIP increment v* - v then carries the contact impulse to the
+    // particles, as it carries the walls' (a corrected v would let FLIP particles keep their
+    // approach velocity).
+    int occupied = 0, rigid = -1;
+    for (int a = 0; a < materials; ++a)
+      if (m[a] > empty) {
+        ++occupied;
+        if (table.rigid[a] && rigid < 0) rigid = a;
+      }
+    if (contact && occupied > 1) {
+      double cm[Dim];
+      for (int d = 0; d < Dim; ++d) {
+        if (rigid >= 0) {
+          cm[d] = table.rigid_velocity[rigid][d];
+        } else {
+          double momentum = 0.0, total = 0.0;
+          for (int a = 0; a < materials; ++a)
+            if (m[a] > empty) momentum += m[a] * v[a][d], total += m[a];
+          cm[d] = momentum / total;
+        }
+      }
+      for (int a = 0; a < materials; ++a) {
+        if (!(m[a] > empty) || table.rigid[a]) continue;
+        double n[Dim], norm2 = 0.0;
+        for (int d = 0; d < Dim; ++d) {
+          n[d] = -sums(i, col.massGradient(a, d));  // outward: mass decreases outwards
+          norm2 += n[d] * n[d];
+        }
+        if (!(norm2 > 0.0)) continue;
+        const double inv = 1.0 / math::sqrt(norm2);
+        for (int d = 0; d < Dim; ++d) n[d] *= inv;
+        frictionalContact<Dim>(v[a], cm, n, mu_contact);
+      }
+    }
+
+    // Walls: nodes on a domain face.
+    for (int d = 0; d < Dim; ++d) {
+      for (int side = 0; side < 2; ++side) {
+        if (ijk(i, d) != (side == 0 ? 0 : last_node[d])) continue;
+        const int face = 2 * d + side;
+        double n[Dim], zero[Dim];
+        for (int e = 0; e < Dim; ++e) n[e] = 0.0, zero[e] = 0.0;
+        n[d] = side == 0 ? -1.0 : 1.0;  // outward normal of the domain
+        for (int a = 0; a < materials; ++a) {
+          if (table.rigid[a]) continue;
+          if (no_slip[face]) {
+            for (int e = 0; e < Dim; ++e) v[a][e] = 0.0;
+          } else {
+            frictionalContact<Dim>(v[a], zero, n, mu_wall);
+          }
+        }
+      }
+    }
+  }
+};
+
+template <int Dim>
+GridConditions<Dim> gridConditions(const Layout<Dim>& layout, const std::vector<SolidMaterial>& materials,
+                                   const MpmOptions& options, double empty_node_mass,
+                                   const std::array<int, 2 * Dim>& wall_no_slip)
+{
+  GridConditions<Dim> c;
+  c.materials = int(materials.size());
+  c.col = NodeColumns{std::max(1, c.materials), Dim};
+  c.table = materialTable(materials);
+  c.empty = empty_node_mass;
+  c.contact = options.contact && c.materials > 1;
+  c.mu_contact = options.contact_friction;
+  c.mu_wall = options.wall_friction;
+  for (int f = 0; f < 2 * Dim; ++f) c.no_slip[f] = wall_no_slip[f];
+  for (int d = 0; d < Dim; ++d) c.last_node[d] = layout.grid().nodes()[d] - 1;
+  c.ijk = layout.nodeIndex();
+  return c;
+}
+
 }  // namespace
 
 template <int Dim>
@@ -123,6 +218,8 @@ void MpmSolver<Dim>::allocateNodeFields()
   node_sums_ = std::make_unique<Field<Dim>>(layout_, Location::Node, columns.count(gradients), "mpm node sums");
   node_velocity_ = std::make_unique<Field<Dim>>(layout_, Location::Node, nm * Dim, "mpm node velocity");
   node_velocity_star_ = std::make_unique<Field<Dim>>(layout_, Location::Node, nm * Dim, "mpm node velocity star");
+  if (options_.stress_update == StressUpdate::ModifiedLast)
+    node_velocity_new_ = std::make_unique<Field<Dim>>(layout_, Location::Node, nm * Dim, "mpm node velocity new");
 }
 
 template <int Dim>
@@ -250,20 +347,12 @@ void MpmSolver<Dim>::particlesToGridWith()
 template <int Dim>
 void MpmSolver<Dim>::integrateGrid(double dt)
 {
-  const Grid<Dim>& grid = layout_->grid();
   const int nm = int(materials_.size());
   const NodeColumns col{std::max(1, nm), Dim};
-  const bool contact = options_.contact && nm > 1;
   const MaterialTable table = materialTable(materials_);
   const double empty = empty_node_mass_;
   const double alpha = options_.velocity_damping;
-  const double mu_contact = options_.contact_friction;
-  const double mu_wall = options_.wall_friction;
-  const auto ijk = layout_->nodeIndex();
-  int no_slip[2 * Dim];
-  long long last_node[Dim];
-  for (int f = 0; f < 2 * Dim; ++f) no_slip[f] = wall_no_slip_[f];
-  for (int d = 0; d < Dim; ++d) last_node[d] = grid.nodes()[d] - 1;
+  const GridConditions<Dim> conditions = gridConditions<Dim>(*layout_, materials_, options_, empty_node_mass_, wall_no_slip_);
   const auto sums = node_sums_->view();
   auto velocity = node_velocity_->view();
   auto velocity_star = node_velocity_star_->view();
@@ -272,14 +361,10 @@ void MpmSolver<Dim>::integrateGrid(double dt)
       "mpm::integrate_grid", Kokkos::RangePolicy<ExecutionSpace>(0, node_sums_->overlapCount()),
       KOKKOS_LAMBDA(const int i) {
         double v[kMaxMaterials][Dim], vs[kMaxMaterials][Dim], m[kMaxMaterials];
-        int occupied = 0, rigid = -1;
         for (int a = 0; a < nm; ++a) {
           m[a] = sums(i, col.mass(a));
-          const bool has_mass = m[a] > empty;
-          if (has_mass) ++occupied;
-          if (has_mass && table.rigid[a] && rigid < 0) rigid = a;
           for (int d = 0; d < Dim; ++d) {
-            if (!has_mass) {
+            if (!(m[a] > empty)) {
               v[a][d] = vs[a][d] = 0.0;
             } else if (table.rigid[a]) {
               v[a][d] = vs[a][d] = table.rigid_velocity[a][d];
@@ -289,57 +374,7 @@ void MpmSolver<Dim>::integrateGrid(double dt)
             }
           }
         }
-
-        // Contact where two or more materials meet: each approaching material loses its normal
-        // velocity relative to the centre of mass (a rigid material's velocity when one is there).
-        // Only v* is corrected: the FLIP increment v* - v then carries the contact impulse to the
-        // particles, as it carries the walls' (a corrected v would let FLIP particles keep their
-        // approach velocity).
-        if (contact && occupied > 1) {
-          double cm_star[Dim];
-          for (int d = 0; d < Dim; ++d) {
-            if (rigid >= 0) {
-              cm_star[d] = table.rigid_velocity[rigid][d];
-            } else {
-              double ps = 0.0, total = 0.0;
-              for (int a = 0; a < nm; ++a)
-                if (m[a] > empty) ps += m[a] * vs[a][d], total += m[a];
-              cm_star[d] = ps / total;
-            }
-          }
-          for (int a = 0; a < nm; ++a) {
-            if (!(m[a] > empty) || table.rigid[a]) continue;
-            double n[Dim], norm2 = 0.0;
-            for (int d = 0; d < Dim; ++d) {
-              n[d] = -sums(i, col.massGradient(a, d));  // outward: mass decreases outwards
-              norm2 += n[d] * n[d];
-            }
-            if (!(norm2 > 0.0)) continue;
-            const double inv = 1.0 / math::sqrt(norm2);
-            for (int d = 0; d < Dim; ++d) n[d] *= inv;
-            frictionalContact<Dim>(vs[a], cm_star, n, mu_contact);
-          }
-        }
-
-        // Walls: nodes on a domain face.
-        for (int d = 0; d < Dim; ++d) {
-          for (int side = 0; side < 2; ++side) {
-            if (ijk(i, d) != (side == 0 ? 0 : last_node[d])) continue;
-            const int face = 2 * d + side;
-            double n[Dim], zero[Dim];
-            for (int e = 0; e < Dim; ++e) n[e] = 0.0, zero[e] = 0.0;
-            n[d] = side == 0 ? -1.0 : 1.0;  // outward normal of the domain
-            for (int a = 0; a < nm; ++a) {
-              if (table.rigid[a]) continue;
-              if (no_slip[face]) {
-                for (int e = 0; e < Dim; ++e) vs[a][e] = 0.0;
-              } else {
-                frictionalContact<Dim>(vs[a], zero, n, mu_wall);
-              }
-            }
-          }
-        }
-
+        conditions.apply(i, sums, m, vs);
         for (int a = 0; a < nm; ++a)
           for (int d = 0; d < Dim; ++d) {
             velocity(i, a * Dim + d) = v[a][d];
@@ -349,19 +384,25 @@ void MpmSolver<Dim>::integrateGrid(double dt)
 }
 
 /// G2P: v_p <- f (v_p + sum_i w_ip (v*_i - v_i)) + (1 - f) sum_i w_ip v*_i   (FLIP share f),
-///      x_p <- x_p + dt sum_i w_ip v*_i,   L_p = sum_i v*_i (x) grad w_ip,
-///      F_p <- (I + dt L_p) F_p,   V_p = det(F_p) V_p0.
-/// Each particle reads its own material's node velocities. Rigid particles move with their
-/// prescribed velocity and keep F = I.
+///      x_p <- x_p + dt sum_i w_ip v*_i,   L_p = sum_i u_i (x) grad w_ip,
+///      F_p <- (I + dt L_p) F_p,   V_p = det(F_p) V_p0,
+/// with u = v* (USL) or, for MUSL, u = the updated particle momenta mapped back to the nodes,
+/// u_i = sum_p w_ip m_p v_p / m_i, under the same contact and wall conditions as v*. All weights
+/// are those of the positions at the start of the step. Each particle reads its own material's
+/// node velocities. Rigid particles move with their prescribed velocity and keep F = I.
 template <int Dim>
 template <class Kernel>
 void MpmSolver<Dim>::gridToParticlesWith(double dt)
 {
   const Grid<Dim>& grid = layout_->grid();
+  const int nm = int(materials_.size());
+  const NodeColumns col{std::max(1, nm), Dim};
   const MaterialTable table = materialTable(materials_);
   const double flip = options_.flip_fraction;
+  const bool remap = options_.stress_update == StressUpdate::ModifiedLast;
   const auto x = particles_.position;
   const auto v = particles_.velocity;
+  const auto mass = particles_.mass;
   const auto volume = particles_.volume;
   const auto initial_volume = particles_.initial_volume;
   const auto F = particles_.deformation_gradient;
@@ -373,6 +414,63 @@ void MpmSolver<Dim>::gridToParticlesWith(double dt)
   const auto node_vs = node_velocity_star_->view();
   double origin[Dim], spacing[Dim];
   for (int d = 0; d < Dim; ++d) origin[d] = grid.lower()[d], spacing[d] = grid.spacing()[d];
+
+  // MUSL: the velocity update and the momentum it maps back, then the grid velocity u.
+  if (remap) {
+    node_velocity_new_->fill(0.0);
+    auto momentum = node_velocity_new_->view();
+    Kokkos::parallel_for(
+        "mpm::grid_to_particles_velocity", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count),
+        KOKKOS_LAMBDA(const int p) {
+          const int m = material(p);
+          if (table.rigid[m]) return;
+          double xp[Dim], lp[Dim];
+          for (int d = 0; d < Dim; ++d) xp[d] = x(p, d), lp[d] = half_width(p, d);
+          ShapeStencil<Dim, Kernel> s;
+          evaluateShape(xp, origin, spacing, lp, s);
+          LocalOrdinal lids[ShapeStencil<Dim, Kernel>::size];
+          double v_grid[Dim] = {}, dv[Dim] = {}, vp[Dim];
+          for (int k = 0; k < s.size; ++k) {
+            long long node[3] = {0, 0, 0};
+            s.node(k, node);
+            lids[k] = lookup(node[0], node[1], node[2]);
+            if (lids[k] < 0) continue;
+            const double w = s.weight[k];
+            for (int d = 0; d < Dim; ++d) {
+              const double vs = node_vs(lids[k], m * Dim + d);
+              v_grid[d] += w * vs;
+              dv[d] += w * (vs - node_v(lids[k], m * Dim + d));
+            }
+          }
+          for (int d = 0; d < Dim; ++d) vp[d] = v(p, d) = flip * (v(p, d) + dv[d]) + (1.0 - flip) * v_grid[d];
+          const double mp = mass(p);
+          for (int k = 0; k < s.size; ++k) {
+            if (lids[k] < 0) continue;
+            for (int d = 0; d < Dim; ++d) Kokkos::atomic_add(&momentum(lids[k], m * Dim + d), s.weight[k] * mp * vp[d]);
+          }
+        });
+    node_velocity_new_->sumToOwners();
+    const GridConditions<Dim> conditions =
+        gridConditions<Dim>(*layout_, materials_, options_, empty_node_mass_, wall_no_slip_);
+    const auto sums = node_sums_->view();
+    const double empty = empty_node_mass_;
+    Kokkos::parallel_for(
+        "mpm::remapped_grid_velocity", Kokkos::RangePolicy<ExecutionSpace>(0, node_sums_->overlapCount()),
+        KOKKOS_LAMBDA(const int i) {
+          double u[kMaxMaterials][Dim] = {}, m[kMaxMaterials] = {};
+          for (int a = 0; a < nm; ++a) {
+            m[a] = sums(i, col.mass(a));
+            for (int d = 0; d < Dim; ++d)
+              u[a][d] = !(m[a] > empty) ? 0.0
+                        : table.rigid[a] ? table.rigid_velocity[a][d]
+                                         : momentum(i, a * Dim + d) / m[a];
+          }
+          conditions.apply(i, sums, m, u);
+          for (int a = 0; a < nm; ++a)
+            for (int d = 0; d < Dim; ++d) momentum(i, a * Dim + d) = u[a][d];
+        });
+  }
+  const auto node_u = remap ? node_velocity_new_->view() : node_vs;
 
   Kokkos::parallel_for(
       "mpm::grid_to_particles", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count), KOKKOS_LAMBDA(const int p) {
@@ -401,12 +499,13 @@ void MpmSolver<Dim>::gridToParticlesWith(double dt)
             const double vs = node_vs(lid, m * Dim + d);
             v_grid[d] += w * vs;
             dv[d] += w * (vs - node_v(lid, m * Dim + d));
-            for (int e = 0; e < Dim; ++e) grad_v(d, e) += vs * s.gradient[k][e];
+            const double u = node_u(lid, m * Dim + d);
+            for (int e = 0; e < Dim; ++e) grad_v(d, e) += u * s.gradient[k][e];
           }
         }
         Mat<Dim> Fp;
         for (int d = 0; d < Dim; ++d) {
-          v(p, d) = flip * (v(p, d) + dv[d]) + (1.0 - flip) * v_grid[d];
+          if (!remap) v(p, d) = flip * (v(p, d) + dv[d]) + (1.0 - flip) * v_grid[d];
           x(p, d) += dt * v_grid[d];
           for (int e = 0; e < Dim; ++e) {
             L(p, d, e) = grad_v(d, e);
@@ -420,7 +519,7 @@ void MpmSolver<Dim>::gridToParticlesWith(double dt)
       });
 }
 
-/// The constitutive update, last in the step (USL), with the velocity gradient of G2P. Dispatch on
+/// The constitutive update, last in the step (USL or MUSL), with the velocity gradient of G2P. Dispatch on
 /// the model happens once per material (SolidModel::visit); the kernel holds the concrete model.
 template <int Dim>
 void MpmSolver<Dim>::updateStress(double dt)

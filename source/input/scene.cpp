@@ -628,6 +628,23 @@ TimeSpec readTime(ParameterList& list)
   return time;
 }
 
+MpmSpec readMpm(ParameterList& list)
+{
+  const std::string path = kRoot + ".mpm";
+  const ParameterList& valid = validSceneParameters()->sublist("mpm");
+  checkKeys(list, valid, path, 0);
+  setDefaults(list, valid, path);
+  MpmSpec mpm;
+  mpm.shape_function = list.get<std::string>("shape_function");
+  mpm.flip_fraction = list.get<double>("flip_fraction");
+  mpm.stress_update = list.get<std::string>("stress_update");
+  mpm.wall_friction = list.get<double>("wall_friction");
+  mpm.contact = list.get<bool>("contact");
+  mpm.contact_friction = list.get<double>("contact_friction");
+  mpm.velocity_damping = list.get<double>("velocity_damping");
+  return mpm;
+}
+
 OutputSpec readOutput(ParameterList& list)
 {
   const std::string path = kRoot + ".output";
@@ -688,6 +705,7 @@ Scene readScene(const std::string& path)
                                       scene.initial.temperature);
     scene.time = readTime(root->sublist("time"));
     scene.output = readOutput(root->sublist("output"));
+    scene.mpm = readMpm(root->sublist("mpm"));
   } catch (const InputError& error) {
     throw InputError(path + ": " + error.what());
   }

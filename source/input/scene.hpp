@@ -73,6 +73,17 @@ struct InitialStateSpec {
   bool hydrostatic = true;          // integrate the pressure down from the top with the column's weight
 };
 
+/// The `mpm` section: settings of the particle solver (doc/mpm.md explains each).
+struct MpmSpec {
+  std::string shape_function = "gimp";  // gimp | linear
+  double flip_fraction = 0.99;          // in [0, 1]
+  std::string stress_update = "usl";    // usl | musl
+  double wall_friction = 0.0;           // Coulomb coefficient at free_slip walls
+  bool contact = true;                  // friction contact between solid materials
+  double contact_friction = 0.0;        // Coulomb coefficient between solid materials
+  double velocity_damping = 0.0;        // 1/s
+};
+
 struct Scene {
   std::string path;
   std::string title;
@@ -83,6 +94,7 @@ struct Scene {
   std::vector<BoundarySpec> boundaries; // one per face of the domain (4 in 2-D, 6 in 3-D)
   TimeSpec time;
   OutputSpec output;
+  MpmSpec mpm;
   Teuchos::RCP<Teuchos::ParameterList> parameters;  // the whole validated list, defaults filled in
 
   int materialIndex(const std::string& name) const;  // throws InputError if unknown
@@ -90,8 +102,8 @@ struct Scene {
 
 /// The list of valid parameters with defaults and documentation; the single source of truth for
 /// validation and for doc/input.md. Each entry carries a ParameterRule (input/parameter_rule.hpp).
-/// The named-entry sections (materials, regions, boundary_conditions) and the solver sections (ice,
-/// mpm) are empty here: their entries follow the templates below.
+/// The named-entry sections (materials, regions, boundary_conditions) and the `ice` section are empty
+/// here: their entries follow the templates below, or the ICE solver checks them.
 Teuchos::RCP<const Teuchos::ParameterList> validSceneParameters();
 
 /// Templates for named entries, one per value of their selector key (which each template holds):

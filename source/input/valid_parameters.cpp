@@ -161,6 +161,32 @@ void defineOutput(ParameterList& output)
          atLeast(0, "s"));
 }
 
+void defineMpm(ParameterList& mpm)
+{
+  define(mpm, "shape_function", std::string("gimp"),
+         "Particle-grid weights: `gimp` (uGIMP, no cell-crossing noise) or `linear` (hat functions, for comparison).",
+         oneOf({"gimp", "linear"}));
+  define(mpm, "flip_fraction", 0.99,
+         "FLIP share of the particle velocity update (1: pure FLIP, 0: pure PIC, which damps strongly).",
+         between(0, false, 1, false));
+  define(mpm, "stress_update", std::string("usl"),
+         "Where the strain rate comes from: `usl` (updated grid velocity, as Uintah) or `musl` (particle "
+         "momenta mapped back to the grid: no systematic energy loss, ~1.45x the step cost; not yet right "
+         "with contact between materials).",
+         oneOf({"usl", "musl"}));
+  define(mpm, "wall_friction", 0.0,
+         "Coulomb friction coefficient between particles and the `free_slip` walls (`no_slip` walls stick).",
+         atLeast(0, ""));
+  define(mpm, "contact", true,
+         "true: Coulomb friction contact with free separation between solid materials; false: each material "
+         "moves through the others.",
+         ParameterRule{});
+  define(mpm, "contact_friction", 0.0, "Coulomb friction coefficient between solid materials.", atLeast(0, ""));
+  define(mpm, "velocity_damping", 0.0,
+         "Mass-proportional damping of the node velocities, to reach a static state; 0 for dynamics.",
+         atLeast(0, "1/s"));
+}
+
 RCP<ParameterList> buildSceneParameters()
 {
   auto scene = Teuchos::rcp(new ParameterList("cfdmpm"));
@@ -183,7 +209,7 @@ RCP<ParameterList> buildSceneParameters()
   defineTime(defineSection(*scene, "time", "Time span and time-step control.", true, false));
   defineOutput(defineSection(*scene, "output", "What is written, where and how often.", true, false));
   defineSection(*scene, "ice", "Settings of the fluid (ICE) solver; checked by that solver.", false, true);
-  defineSection(*scene, "mpm", "Settings of the particle (MPM) solver; checked by that solver.", false, true);
+  defineMpm(defineSection(*scene, "mpm", "Settings of the particle (MPM) solver.", false, false));
   return scene;
 }
 

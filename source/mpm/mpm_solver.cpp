@@ -748,6 +748,19 @@ ParticleOutput MpmSolver<Dim>::output() const
   return out;
 }
 
+MpmOptions optionsFromScene(const Scene& scene)
+{
+  MpmOptions options;
+  options.shape_function = scene.mpm.shape_function == "linear" ? ShapeFunction::Linear : ShapeFunction::Gimp;
+  options.flip_fraction = scene.mpm.flip_fraction;
+  options.stress_update = scene.mpm.stress_update == "musl" ? StressUpdate::ModifiedLast : StressUpdate::Last;
+  options.wall_friction = scene.mpm.wall_friction;
+  options.contact = scene.mpm.contact;
+  options.contact_friction = scene.mpm.contact_friction;
+  options.velocity_damping = scene.mpm.velocity_damping;
+  return options;
+}
+
 template class MpmSolver<2>;
 template class MpmSolver<3>;
 

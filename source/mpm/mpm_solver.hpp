@@ -39,7 +39,8 @@ enum class StressUpdate {
   ModifiedLast
 };
 
-/// Solver settings that the scene file does not (yet) hold; doc/mpm.md explains each.
+/// Solver settings; the scene's `mpm` section sets them (optionsFromScene), tests set them directly.
+/// doc/mpm.md explains each.
 struct MpmOptions {
   ShapeFunction shape_function = ShapeFunction::Gimp;
   /// Share of FLIP in the G2P velocity update: v_p <- f (v_p + dv_grid) + (1 - f) v_grid.
@@ -48,7 +49,7 @@ struct MpmOptions {
   /// Velocity the strain rate is taken from: v* (USL) or the re-mapped particle momenta (MUSL).
   StressUpdate stress_update = StressUpdate::Last;
   /// Coulomb friction coefficient mu between particles and the free_slip walls of the domain
-  /// (no_slip walls stick). Not in the input file yet.
+  /// (no_slip walls stick).
   double wall_friction = 0.0;
   /// Contact between MPM materials (Bardenhagen et al. 2001, Coulomb friction, free separation).
   /// Off: the materials do not see each other (each has its own node velocities) and pass through
@@ -61,6 +62,9 @@ struct MpmOptions {
   /// Courant number of the time step; <= 0 takes the scene's time.cfl.
   double cfl = 0.0;
 };
+
+/// The options the scene's `mpm` section asks for (its values were checked when it was read).
+MpmOptions optionsFromScene(const Scene& scene);
 
 /// What the time step is limited by on the whole domain.
 struct MpmTimeStep {

@@ -114,7 +114,7 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
     physics.limit = [&](double previous) { return ice->stableTimeStep(state, previous); };
     physics.advance = [&](double dt) { ice_report = ice->step(state, dt); };
   } else if (!fluids_move && has_solids) {
-    particles = std::make_unique<mpm::MpmSolver<Dim>>(scene, layout);
+    particles = std::make_unique<mpm::MpmSolver<Dim>>(scene, layout, mpm::optionsFromScene(scene));
     physics.columns = {"particles"};
     for (const auto& m : scene.materials)
       if (m.kind == "solid") physics.columns.push_back("mass_" + m.name);

@@ -42,6 +42,18 @@ TEST_F(SceneTest, KeyGivenTwiceIsASyntaxError)
   expectMentions(message, {"scene.yaml", "line", "\"ghost_width\" already exists"});
 }
 
+TEST_F(SceneTest, MpmSettingsAreChecked)
+{
+  expectMentions(errorOf(replaced(kFullScene, "  mpm: {}\n", "  mpm: {stress_update: usf}\n")),
+                 {"cfdmpm.mpm.stress_update", "usf", "usl", "musl"});
+  expectMentions(errorOf(replaced(kFullScene, "  mpm: {}\n", "  mpm: {flip_fraction: 1.5}\n")),
+                 {"cfdmpm.mpm.flip_fraction", "1.5", "[0, 1]"});
+  expectMentions(errorOf(replaced(kFullScene, "  mpm: {}\n", "  mpm: {wall_friction: -0.1}\n")),
+                 {"cfdmpm.mpm.wall_friction", "-0.1", ">= 0"});
+  expectMentions(errorOf(replaced(kFullScene, "  mpm: {}\n", "  mpm: {friction: 0.2}\n")),
+                 {"cfdmpm.mpm.friction", "wall_friction"});
+}
+
 TEST_F(SceneTest, SecondTopLevelKeyIsRefusedWithItsLine)
 {
   // Teuchos would drop this section without a word.

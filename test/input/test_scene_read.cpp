@@ -147,6 +147,28 @@ TEST_F(SceneTest, MissingKeysTakeTheirDefaults)
   EXPECT_TRUE(scene.parameters->isSublist("ice"));
   EXPECT_TRUE(scene.parameters->isSublist("mpm"));
   EXPECT_EQ(scene.parameters->sublist("domain").get<int>("ghost_width"), 2);
+  EXPECT_EQ(scene.mpm.shape_function, "gimp");
+  EXPECT_EQ(scene.mpm.flip_fraction, 0.99);
+  EXPECT_EQ(scene.mpm.stress_update, "usl");
+  EXPECT_EQ(scene.mpm.wall_friction, 0.0);
+  EXPECT_TRUE(scene.mpm.contact);
+  EXPECT_EQ(scene.mpm.contact_friction, 0.0);
+  EXPECT_EQ(scene.mpm.velocity_damping, 0.0);
+}
+
+TEST_F(SceneTest, MpmSectionIsRead)
+{
+  const Scene scene = readScene(write(replaced(
+      kFullScene, "  mpm: {}\n",
+      "  mpm: {shape_function: linear, flip_fraction: 1, stress_update: musl, wall_friction: 0.2, contact: false, "
+      "contact_friction: 0.3, velocity_damping: 5.0}\n")));
+  EXPECT_EQ(scene.mpm.shape_function, "linear");
+  EXPECT_EQ(scene.mpm.flip_fraction, 1.0);  // an integer where a number is expected
+  EXPECT_EQ(scene.mpm.stress_update, "musl");
+  EXPECT_EQ(scene.mpm.wall_friction, 0.2);
+  EXPECT_FALSE(scene.mpm.contact);
+  EXPECT_EQ(scene.mpm.contact_friction, 0.3);
+  EXPECT_EQ(scene.mpm.velocity_damping, 5.0);
 }
 
 TEST_F(SceneTest, IntegersAreAcceptedWhereNumbersAreExpected)

@@ -113,20 +113,22 @@ struct Slabs {
     return total;
   }
 
-  /// Offset from the cell centre to the centroid of the outflow slab of face f, given its
-  /// fraction. Normal to the face: the slab of thickness |u|Δt against the face. Along the face:
-  /// the donor's mean transverse velocity times -Δt/2 (the swept region's centroid).
-  KOKKOS_INLINE_FUNCTION void centroidOffset(int c, int f, int m, double fraction, double r[Dim]) const
+  /// For every face f of cell c and material m: the outflow fraction (as outflowFraction) and the
+  /// offset r[f] from the cell centre to the centroid of the outflow slab. Normal to the face: the
+  /// slab of thickness |u|Δt against the face. Along the face: the donor's mean transverse velocity
+  /// times -Δt/2 (the swept region's centroid). The cell's 2 Dim face velocities are read once.
+  KOKKOS_INLINE_FUNCTION void cellSlabs(int c, int m, double fraction[2 * Dim], double r[2 * Dim][Dim]) const
   {
-    const int d = f / 2;
-    for (int e = 0; e < Dim; ++e) {
-      if (e == d) {
-        r[e] = (f % 2 == 0 ? -0.5 : 0.5) * spacing[d] * (1.0 - fraction);
-      } else if (transverse) {
-        const double mean = 0.5 * (normalVelocity(c, 2 * e, m) + normalVelocity(c, 2 * e + 1, m));
-        r[e] = -0.5 * dt * mean;
-      } else {
-        r[e] = 0.0;
+    double u[2 * Dim];
+    for (int f = 0; f < 2 * Dim; ++f) u[f] = normalVelocity(c, f, m);
+    for (int f = 0; f < 2 * Dim; ++f) {
+      const int d = f / 2;
+      const double outward = f % 2 == 0 ? -u[f] : u[f];
+      fraction[f] = outward > 0 ? outward * dt / spacing[d] : 0.0;
+      for (int e = 0; e < Dim; ++e) {
+        if (e == d) r[f][e] = (f % 2 == 0 ? -0.5 : 0.5) * spacing[d] * (1.0 - fraction[f]);
+        else if (transverse) r[f][e] = -0.5 * dt * (0.5 * (u[2 * e] + u[2 * e + 1]));
+        else r[f][e] = 0.0;
       }
     }
   }
@@ -286,30 +288,30 @@ void Advector<Dim>::reconstructMass(const FaceField<Dim>& face_velocity, double 
   // w = V_out / V_cell carries w·(M + φ g·r_f) (Uintah's SecondOrderAdvector with compatible
   // fluxes; the remainder bound keeps the mass left behind >= 0 at any outflow Courant number <= 1).
   Kokkos::parallel_for(
-      "advection mass slabs", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->overlapCells() * materials),
-      KOKKOS_LAMBDA(int i) {
-        const int c = i / materials, m = i % materials;
-        double g[Dim], spread = 0;
-        for (int d = 0; d < Dim; ++d) {
-          g[d] = stencil.gradient(M, c, m, d);
-          spread += 0.5 * (g[d] < 0 ? -g[d] : g[d]) * stencil.spacing[d];
+      "advection mass slabs", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->overlapCells()),
+      KOKKOS_LAMBDA(int c) {
+        for (int m = 0; m < materials; ++m) {
+          double fraction[2 * Dim], r[2 * Dim][Dim];
+          slabs.cellSlabs(c, m, fraction, r);
+          double g[Dim], spread = 0;
+          for (int d = 0; d < Dim; ++d) {
+            g[d] = stencil.gradient(M, c, m, d);
+            spread += 0.5 * (g[d] < 0 ? -g[d] : g[d]) * stencil.spacing[d];
+          }
+          double slope[2 * Dim];  // g·r_f
+          double remaining = 1.0, S = 0.0;
+          for (int f = 0; f < 2 * Dim; ++f) {
+            slope[f] = 0;
+            for (int d = 0; d < Dim; ++d) slope[f] += g[d] * r[f][d];
+            remaining -= fraction[f];
+            S += fraction[f] * slope[f];
+          }
+          double lo, hi;
+          stencil.blockBounds(M, c, m, lo, hi);
+          const double value = M(c, m);
+          const double phi = limiter(value, lo, hi, spread, remaining > 0 ? remaining : 0.0, S);
+          for (int f = 0; f < 2 * Dim; ++f) outflow_mass(c, f, m) = fraction[f] * (value + phi * slope[f]);
         }
-        double fraction[2 * Dim], slope[2 * Dim];  // slope: g·r_f
-        double remaining = 1.0, S = 0.0;
-        for (int f = 0; f < 2 * Dim; ++f) {
-          fraction[f] = slabs.outflowFraction(c, f, m);
-          double r[Dim];
-          slabs.centroidOffset(c, f, m, fraction[f], r);
-          slope[f] = 0;
-          for (int d = 0; d < Dim; ++d) slope[f] += g[d] * r[d];
-          remaining -= fraction[f];
-          S += fraction[f] * slope[f];
-        }
-        double lo, hi;
-        stencil.blockBounds(M, c, m, lo, hi);
-        const double value = M(c, m);
-        const double phi = limiter(value, lo, hi, spread, remaining > 0 ? remaining : 0.0, S);
-        for (int f = 0; f < 2 * Dim; ++f) outflow_mass(c, f, m) = fraction[f] * (value + phi * slope[f]);
       });
 }
 
@@ -367,38 +369,37 @@ void Advector<Dim>::reconstructQuantities(const FaceField<Dim>& face_velocity, d
   // within bounds (compatible fluxes). The slab geometry and the mass left behind depend on the
   // cell and material only: computed once for all columns.
   Kokkos::parallel_for(
-      "advection quantity slabs", Kokkos::RangePolicy<ExecutionSpace>(0, cells * materials), KOKKOS_LAMBDA(int i) {
-        const int c = i / materials, m = i % materials;
-        double r[2 * Dim][Dim];
-        double remaining = M(c, m);
-        for (int f = 0; f < 2 * Dim; ++f) {
-          slabs.centroidOffset(c, f, m, slabs.outflowFraction(c, f, m), r[f]);
-          remaining -= outflow_mass(c, f, m);
-        }
-        if (!(remaining > 0)) remaining = 0.0;
-        for (int field = 0; field < q.fields; ++field) {
-          const auto& Q = q.field[field];
-          for (int j = 0; j < q.width[field]; ++j) {
-            const int col = m * q.width[field] + j, slot = q.first[field] + col;
-            double g[Dim], spread = 0;
-            for (int d = 0; d < Dim; ++d) {
-              g[d] = stencil.gradient(Q, c, col, d);
-              spread += 0.5 * (g[d] < 0 ? -g[d] : g[d]) * stencil.spacing[d];
+      "advection quantity slabs", Kokkos::RangePolicy<ExecutionSpace>(0, cells), KOKKOS_LAMBDA(int c) {
+        for (int m = 0; m < materials; ++m) {
+          double fraction[2 * Dim], r[2 * Dim][Dim];
+          slabs.cellSlabs(c, m, fraction, r);
+          double remaining = M(c, m);
+          for (int f = 0; f < 2 * Dim; ++f) remaining -= outflow_mass(c, f, m);
+          if (!(remaining > 0)) remaining = 0.0;
+          for (int field = 0; field < q.fields; ++field) {
+            const auto& Q = q.field[field];
+            for (int j = 0; j < q.width[field]; ++j) {
+              const int col = m * q.width[field] + j, slot = q.first[field] + col;
+              double g[Dim], spread = 0;
+              for (int d = 0; d < Dim; ++d) {
+                g[d] = stencil.gradient(Q, c, col, d);
+                spread += 0.5 * (g[d] < 0 ? -g[d] : g[d]) * stencil.spacing[d];
+              }
+              double slope[2 * Dim];
+              double S = 0.0;
+              for (int f = 0; f < 2 * Dim; ++f) {
+                slope[f] = 0;
+                for (int d = 0; d < Dim; ++d) slope[f] += g[d] * r[f][d];
+                S += outflow_mass(c, f, m) * slope[f];
+              }
+              double lo, hi;
+              stencil.blockBounds(Q, c, col, lo, hi);
+              const double value = Q(c, col);
+              const double phi = limiter(value, lo, hi, spread, remaining, S);
+              for (int f = 0; f < 2 * Dim; ++f) outflow_value(c, f, slot) = value + phi * slope[f];
+              bounds(c, slot, 0) = lo;
+              bounds(c, slot, 1) = hi;
             }
-            double slope[2 * Dim];
-            double S = 0.0;
-            for (int f = 0; f < 2 * Dim; ++f) {
-              slope[f] = 0;
-              for (int d = 0; d < Dim; ++d) slope[f] += g[d] * r[f][d];
-              S += outflow_mass(c, f, m) * slope[f];
-            }
-            double lo, hi;
-            stencil.blockBounds(Q, c, col, lo, hi);
-            const double value = Q(c, col);
-            const double phi = limiter(value, lo, hi, spread, remaining, S);
-            for (int f = 0; f < 2 * Dim; ++f) outflow_value(c, f, slot) = value + phi * slope[f];
-            bounds(c, slot, 0) = lo;
-            bounds(c, slot, 1) = hi;
           }
         }
       });
@@ -420,41 +421,41 @@ void Advector<Dim>::update(Field<Dim>& mass, const std::vector<Field<Dim>*>& mas
   // flux or a uniform q leaves q exactly unchanged:  q_new = q + Σ_f ±F_f (q_f - q) / M_new.
   // Cell c's entries are read and written by its own iteration only, so the update is in place.
   Kokkos::parallel_for(
-      "advection update", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells() * materials),
-      KOKKOS_LAMBDA(int i) {
-        const int c = i / materials, m = i % materials;
-        double mass_new = M(c, m);
-        for (int f = 0; f < 2 * Dim; ++f) {
-          const LocalOrdinal n = neighbours(c, f);
-          const double in = n >= 0 ? outflow_mass(n, f ^ 1, m) : 0.0;
-          mass_new += in - outflow_mass(c, f, m);
-        }
-        for (int field = 0; field < q.fields; ++field) {
-          const auto& Q = q.field[field];
-          for (int j = 0; j < q.width[field]; ++j) {
-            const int col = m * q.width[field] + j, slot = q.first[field] + col;
-            const double value_old = Q(c, col);
-            double lo = bounds(c, slot, 0), hi = bounds(c, slot, 1);
-            double change = 0;
-            for (int f = 0; f < 2 * Dim; ++f) {
-              change -= outflow_mass(c, f, m) * (outflow_value(c, f, slot) - value_old);
-              const LocalOrdinal n = neighbours(c, f);
-              if (n < 0) continue;
-              const double in = outflow_mass(n, f ^ 1, m);
-              if (in == 0) continue;
-              const double q_in = outflow_value(n, f ^ 1, slot);
-              change += in * (q_in - value_old);
-              lo = q_in < lo ? q_in : lo;
-              hi = q_in > hi ? q_in : hi;
-            }
-            double value = mass_new > 0 ? value_old + change / mass_new : value_old;
-            // In exact arithmetic the new q is a mean of the remainder (within [lo, hi] of the
-            // block) and the inflow values, so this only removes round-off, which is large relative
-            // to q only where nearly all the mass has left (then M_new·q is tiny either way).
-            Q(c, col) = value < lo ? lo : (value > hi ? hi : value);
+      "advection update", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()), KOKKOS_LAMBDA(int c) {
+        for (int m = 0; m < materials; ++m) {
+          double mass_new = M(c, m);
+          for (int f = 0; f < 2 * Dim; ++f) {
+            const LocalOrdinal n = neighbours(c, f);
+            const double in = n >= 0 ? outflow_mass(n, f ^ 1, m) : 0.0;
+            mass_new += in - outflow_mass(c, f, m);
           }
+          for (int field = 0; field < q.fields; ++field) {
+            const auto& Q = q.field[field];
+            for (int j = 0; j < q.width[field]; ++j) {
+              const int col = m * q.width[field] + j, slot = q.first[field] + col;
+              const double value_old = Q(c, col);
+              double lo = bounds(c, slot, 0), hi = bounds(c, slot, 1);
+              double change = 0;
+              for (int f = 0; f < 2 * Dim; ++f) {
+                change -= outflow_mass(c, f, m) * (outflow_value(c, f, slot) - value_old);
+                const LocalOrdinal n = neighbours(c, f);
+                if (n < 0) continue;
+                const double in = outflow_mass(n, f ^ 1, m);
+                if (in == 0) continue;
+                const double q_in = outflow_value(n, f ^ 1, slot);
+                change += in * (q_in - value_old);
+                lo = q_in < lo ? q_in : lo;
+                hi = q_in > hi ? q_in : hi;
+              }
+              double value = mass_new > 0 ? value_old + change / mass_new : value_old;
+              // In exact arithmetic the new q is a mean of the remainder (within [lo, hi] of the
+              // block) and the inflow values, so this only removes round-off, which is large relative
+              // to q only where nearly all the mass has left (then M_new·q is tiny either way).
+              Q(c, col) = value < lo ? lo : (value > hi ? hi : value);
+            }
+          }
+          M(c, m) = mass_new;
         }
-        M(c, m) = mass_new;
       });
 }
 

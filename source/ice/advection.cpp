@@ -1,10 +1,11 @@
 // Advection kernels. One step, per material (doc/ice-advection.md):
 //   1. the outflow check: Σ_faces V_out <= V_cell everywhere, or the step is refused;
 //   2. the mass slabs: each cell's limited linear mass profile gives the mass leaving through each
-//      face (owned cells and the first ghost layer, so that every owned face has its donor), and
-//      the new mass, kept aside while the quantities still need the old one;
-//   3. per mass-specific column: the slab values of q, then the new q of the owned cells;
-//   4. the new mass written; ghosts of the outputs refreshed.
+//      face (owned cells and the first ghost layer, so that every owned face has its donor);
+//   3. the slab values of every mass-specific column of every field, in one pass (the slab
+//      geometry and the remaining mass are computed once per cell and material);
+//   4. one pass over the owned cells writes the new mass and the new q of every column in place
+//      (it reads other cells only through the slab arrays); ghosts of the outputs refreshed.
 #include "ice/advection.hpp"
 
 #include <Teuchos_CommHelpers.hpp>
@@ -22,12 +23,12 @@ template <int Dim>
 struct CellStencil {
   typename Layout<Dim>::IndexTable neighbours;  // (cell, face) -> local id, < 0 if none
   typename Layout<Dim>::IjkTable ijk;           // (cell, d) -> global index
-  BoxLookup lookup;                             // global (i, j, k) -> local id
+  Kokkos::View<const LocalOrdinal**, MemorySpace> block;  // (cell, k) -> local id of the 3^Dim block
   double spacing[3] = {1, 1, 1};
   long long cells[3] = {1, 1, 1};
 
-  explicit CellStencil(const Layout<Dim>& layout)
-      : neighbours(layout.cellNeighbours()), ijk(layout.cellIndex()), lookup(layout.cellLookup())
+  CellStencil(const Layout<Dim>& layout, const Kokkos::View<LocalOrdinal**, MemorySpace>& block_table)
+      : neighbours(layout.cellNeighbours()), ijk(layout.cellIndex()), block(block_table)
   {
     for (int d = 0; d < 3; ++d) {
       spacing[d] = layout.grid().spacing()[d];
@@ -47,17 +48,13 @@ struct CellStencil {
   KOKKOS_INLINE_FUNCTION void blockBounds(const View& v, int c, int col, double& lo, double& hi) const
   {
     lo = hi = v(c, col);
-    const long long i = ijk(c, 0), j = ijk(c, 1), k = Dim == 3 ? ijk(c, Dim - 1) : 0;
-    const int kw = Dim == 3 ? 1 : 0;
-    for (int dk = -kw; dk <= kw; ++dk)
-      for (int dj = -1; dj <= 1; ++dj)
-        for (int di = -1; di <= 1; ++di) {
-          const LocalOrdinal n = lookup(i + di, j + dj, k + dk);
-          if (n < 0) continue;
-          const double value = v(n, col);
-          lo = value < lo ? value : lo;
-          hi = value > hi ? value : hi;
-        }
+    for (int k = 0; k < int(block.extent(1)); ++k) {
+      const LocalOrdinal n = block(c, k);
+      if (n < 0) continue;
+      const double value = v(n, col);
+      lo = value < lo ? value : lo;
+      hi = value > hi ? value : hi;
+    }
   }
 
   /// Unlimited gradient of column `col` in direction d: central difference, one-sided next to a
@@ -116,20 +113,22 @@ struct Slabs {
     return total;
   }
 
-  /// Offset from the cell centre to the centroid of the outflow slab of face f, given its
-  /// fraction. Normal to the face: the slab of thickness |u|Δt against the face. Along the face:
-  /// the donor's mean transverse velocity times -Δt/2 (the swept region's centroid).
-  KOKKOS_INLINE_FUNCTION void centroidOffset(int c, int f, int m, double fraction, double r[Dim]) const
+  /// For every face f of cell c and material m: the outflow fraction (as outflowFraction) and the
+  /// offset r[f] from the cell centre to the centroid of the outflow slab. Normal to the face: the
+  /// slab of thickness |u|Δt against the face. Along the face: the donor's mean transverse velocity
+  /// times -Δt/2 (the swept region's centroid). The cell's 2 Dim face velocities are read once.
+  KOKKOS_INLINE_FUNCTION void cellSlabs(int c, int m, double fraction[2 * Dim], double r[2 * Dim][Dim]) const
   {
-    const int d = f / 2;
-    for (int e = 0; e < Dim; ++e) {
-      if (e == d) {
-        r[e] = (f % 2 == 0 ? -0.5 : 0.5) * spacing[d] * (1.0 - fraction);
-      } else if (transverse) {
-        const double mean = 0.5 * (normalVelocity(c, 2 * e, m) + normalVelocity(c, 2 * e + 1, m));
-        r[e] = -0.5 * dt * mean;
-      } else {
-        r[e] = 0.0;
+    double u[2 * Dim];
+    for (int f = 0; f < 2 * Dim; ++f) u[f] = normalVelocity(c, f, m);
+    for (int f = 0; f < 2 * Dim; ++f) {
+      const int d = f / 2;
+      const double outward = f % 2 == 0 ? -u[f] : u[f];
+      fraction[f] = outward > 0 ? outward * dt / spacing[d] : 0.0;
+      for (int e = 0; e < Dim; ++e) {
+        if (e == d) r[f][e] = (f % 2 == 0 ? -0.5 : 0.5) * spacing[d] * (1.0 - fraction[f]);
+        else if (transverse) r[f][e] = -0.5 * dt * (0.5 * (u[2 * e] + u[2 * e + 1]));
+        else r[f][e] = 0.0;
       }
     }
   }
@@ -180,17 +179,28 @@ Advector<Dim>::Advector(std::shared_ptr<const Layout<Dim>> layout, int materials
     throw std::invalid_argument("Advector: needs ghost width >= 2, the layout has " +
                                 std::to_string(layout_->ghostWidth()));
   const LocalOrdinal cells = layout_->overlapCells();
+  constexpr int kBlock = Dim == 2 ? 9 : 27;
+  block_ = Kokkos::View<LocalOrdinal**, MemorySpace>("advection block", cells, kBlock);
+  const auto block = block_;
+  const auto ijk = layout_->cellIndex();
+  const BoxLookup lookup = layout_->cellLookup();
+  Kokkos::parallel_for(
+      "advection block table", Kokkos::RangePolicy<ExecutionSpace>(0, cells), KOKKOS_LAMBDA(const LocalOrdinal c) {
+        const long long i = ijk(c, 0), j = ijk(c, 1), k = Dim == 3 ? ijk(c, Dim - 1) : 0;
+        const int kw = Dim == 3 ? 1 : 0;
+        int slot = 0;
+        for (int dk = -kw; dk <= kw; ++dk)
+          for (int dj = -1; dj <= 1; ++dj)
+            for (int di = -1; di <= 1; ++di) block(c, slot++) = lookup(i + di, j + dj, k + dk);
+      });
   outflow_mass_ = WorkView("advection outflow mass", cells, 2 * Dim, materials);
-  outflow_value_ = WorkView("advection outflow value", cells, 2 * Dim, materials);
-  new_mass_ = Kokkos::View<double**, MemorySpace>("advection new mass", layout_->ownedCells(), materials);
-  new_value_ = Kokkos::View<double**, MemorySpace>("advection new value", layout_->ownedCells(), materials);
 }
 
 template <int Dim>
 AdvectionStatus Advector<Dim>::checkOutflux(const FaceField<Dim>& face_velocity, double dt) const
 {
   const Slabs<Dim> slabs(face_velocity, *layout_, dt, options_.transverse_correction);
-  const CellStencil<Dim> stencil(*layout_);
+  const CellStencil<Dim> stencil(*layout_, block_);
   const int materials = materials_;
   const int entries = layout_->ownedCells() * materials;
 
@@ -207,16 +217,18 @@ AdvectionStatus Advector<Dim>::checkOutflux(const FaceField<Dim>& face_velocity,
   Teuchos::reduceAll(comm, Teuchos::REDUCE_MAX, local_max, Teuchos::outArg(status.max_outflux_fraction));
 
   // The cell that attains the maximum, lowest global id first, so every rank count reports the same.
+  // Only ranks that hold the maximum need to look for it.
   const double global_max = status.max_outflux_fraction;
   long long local_first = LLONG_MAX;
-  Kokkos::parallel_reduce(
-      "advection outflux cell", Kokkos::RangePolicy<ExecutionSpace>(0, entries),
-      KOKKOS_LAMBDA(int i, long long& first) {
-        if (slabs.totalOutflowFraction(i / materials, i % materials) != global_max) return;
-        const long long key = stencil.globalId(i / materials) * materials + i % materials;
-        if (key < first) first = key;
-      },
-      Kokkos::Min<long long>(local_first));
+  if (local_max == global_max)
+    Kokkos::parallel_reduce(
+        "advection outflux cell", Kokkos::RangePolicy<ExecutionSpace>(0, entries),
+        KOKKOS_LAMBDA(int i, long long& first) {
+          if (slabs.totalOutflowFraction(i / materials, i % materials) != global_max) return;
+          const long long key = stencil.globalId(i / materials) * materials + i % materials;
+          if (key < first) first = key;
+        },
+        Kokkos::Min<long long>(local_first));
   long long first = LLONG_MAX;
   Teuchos::reduceAll(comm, Teuchos::REDUCE_MIN, local_first, Teuchos::outArg(first));
   if (first != LLONG_MAX) {
@@ -238,6 +250,9 @@ AdvectionStatus Advector<Dim>::advect(FaceField<Dim>& face_velocity, double dt, 
     if (q->columns() % materials_ != 0)
       throw std::invalid_argument("Advector: " + q->name() + " has " + std::to_string(q->columns()) +
                                   " columns, not a multiple of " + std::to_string(materials_) + " materials");
+  if (int(mass_specific.size()) > kMaxFields)
+    throw std::invalid_argument("Advector: at most " + std::to_string(kMaxFields) + " mass-specific fields, got " +
+                                std::to_string(mass_specific.size()));
 
   // 1. Ghosts of every input are current: fluxes on an owned cell's faces may come from a ghost
   //    donor, whose reconstruction reads the ghosts beyond it.
@@ -250,19 +265,11 @@ AdvectionStatus Advector<Dim>::advect(FaceField<Dim>& face_velocity, double dt, 
   // 2. Mass leaving each cell through each face, from the limited density profile of the donor.
   reconstructMass(face_velocity, dt, mass);
 
-  // 3. Each mass-specific column, one at a time: the slab values, then the compatible update.
-  //    The mass is still the old one here; the new mass is in new_mass_.
-  computeNewMass(mass);
-  for (Field<Dim>* q : mass_specific) {
-    const int components = q->columns() / materials_;
-    for (int j = 0; j < components; ++j) {
-      reconstructQuantity(face_velocity, dt, mass, *q, components, j);
-      updateQuantity(*q, components, j);
-    }
-  }
+  // 3. The slab values of every mass-specific column (the mass is still the old one).
+  if (!mass_specific.empty()) reconstructQuantities(face_velocity, dt, mass, mass_specific);
 
-  // 4. The new mass, and the outputs' ghosts.
-  writeNewMass(mass);
+  // 4. New mass and compatible update of every column, then the outputs' ghosts.
+  update(mass, mass_specific);
   mass.exchangeHalo();
   for (Field<Dim>* q : mass_specific) q->exchangeHalo();
   return status;
@@ -272,7 +279,7 @@ template <int Dim>
 void Advector<Dim>::reconstructMass(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass)
 {
   const Slabs<Dim> slabs(face_velocity, *layout_, dt, options_.transverse_correction);
-  const CellStencil<Dim> stencil(*layout_);
+  const CellStencil<Dim> stencil(*layout_, block_);
   const auto M = mass.view();
   const auto outflow_mass = outflow_mass_;
   const int materials = materials_;
@@ -281,154 +288,174 @@ void Advector<Dim>::reconstructMass(const FaceField<Dim>& face_velocity, double 
   // w = V_out / V_cell carries w·(M + φ g·r_f) (Uintah's SecondOrderAdvector with compatible
   // fluxes; the remainder bound keeps the mass left behind >= 0 at any outflow Courant number <= 1).
   Kokkos::parallel_for(
-      "advection mass slabs", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->overlapCells() * materials),
-      KOKKOS_LAMBDA(int i) {
-        const int c = i / materials, m = i % materials;
-        double g[Dim], spread = 0;
-        for (int d = 0; d < Dim; ++d) {
-          g[d] = stencil.gradient(M, c, m, d);
-          spread += 0.5 * (g[d] < 0 ? -g[d] : g[d]) * stencil.spacing[d];
+      "advection mass slabs", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->overlapCells()),
+      KOKKOS_LAMBDA(int c) {
+        for (int m = 0; m < materials; ++m) {
+          double fraction[2 * Dim], r[2 * Dim][Dim];
+          slabs.cellSlabs(c, m, fraction, r);
+          double g[Dim], spread = 0;
+          for (int d = 0; d < Dim; ++d) {
+            g[d] = stencil.gradient(M, c, m, d);
+            spread += 0.5 * (g[d] < 0 ? -g[d] : g[d]) * stencil.spacing[d];
+          }
+          double slope[2 * Dim];  // g·r_f
+          double remaining = 1.0, S = 0.0;
+          for (int f = 0; f < 2 * Dim; ++f) {
+            slope[f] = 0;
+            for (int d = 0; d < Dim; ++d) slope[f] += g[d] * r[f][d];
+            remaining -= fraction[f];
+            S += fraction[f] * slope[f];
+          }
+          double lo, hi;
+          stencil.blockBounds(M, c, m, lo, hi);
+          const double value = M(c, m);
+          const double phi = limiter(value, lo, hi, spread, remaining > 0 ? remaining : 0.0, S);
+          for (int f = 0; f < 2 * Dim; ++f) outflow_mass(c, f, m) = fraction[f] * (value + phi * slope[f]);
         }
-        double fraction[2 * Dim], slope[2 * Dim];  // slope: g·r_f
-        double remaining = 1.0, S = 0.0;
-        for (int f = 0; f < 2 * Dim; ++f) {
-          fraction[f] = slabs.outflowFraction(c, f, m);
-          double r[Dim];
-          slabs.centroidOffset(c, f, m, fraction[f], r);
-          slope[f] = 0;
-          for (int d = 0; d < Dim; ++d) slope[f] += g[d] * r[d];
-          remaining -= fraction[f];
-          S += fraction[f] * slope[f];
-        }
-        double lo, hi;
-        stencil.blockBounds(M, c, m, lo, hi);
-        const double value = M(c, m);
-        const double phi = limiter(value, lo, hi, spread, remaining > 0 ? remaining : 0.0, S);
-        for (int f = 0; f < 2 * Dim; ++f) outflow_mass(c, f, m) = fraction[f] * (value + phi * slope[f]);
       });
 }
 
+namespace {
+
+/// The mass-specific fields of one advect() call as the kernels see them: field i has `width[i]`
+/// columns per material, and its column m·width + j is column `first[i] + m·width + j` of the
+/// slab arrays.
+template <int Dim, class View, int kMaxFields>
+struct QuantityColumns {
+  Kokkos::Array<View, kMaxFields> field;
+  int width[kMaxFields] = {};
+  int first[kMaxFields] = {};
+  int fields = 0;
+  int total = 0;  // columns of the slab arrays
+};
+
+template <int Dim, int kMaxFields, class View, class FieldPointer>
+QuantityColumns<Dim, View, kMaxFields> quantityColumns(const std::vector<FieldPointer>& mass_specific, int materials)
+{
+  QuantityColumns<Dim, View, kMaxFields> q;
+  for (const FieldPointer field : mass_specific) {
+    q.field[q.fields] = field->view();
+    q.width[q.fields] = field->columns() / materials;
+    q.first[q.fields] = q.total;
+    q.total += field->columns();
+    ++q.fields;
+  }
+  return q;
+}
+
+}  // namespace
+
 template <int Dim>
-void Advector<Dim>::reconstructQuantity(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass,
-                                        const Field<Dim>& quantity, int components, int component)
+void Advector<Dim>::reconstructQuantities(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass,
+                                          const std::vector<Field<Dim>*>& mass_specific)
 {
   const Slabs<Dim> slabs(face_velocity, *layout_, dt, options_.transverse_correction);
-  const CellStencil<Dim> stencil(*layout_);
+  const CellStencil<Dim> stencil(*layout_, block_);
   const auto M = mass.view();
-  const auto Q = quantity.view();
+  const auto q = quantityColumns<Dim, kMaxFields, typename Field<Dim>::ConstView>(
+      std::vector<const Field<Dim>*>(mass_specific.begin(), mass_specific.end()), materials_);
+  const LocalOrdinal cells = layout_->overlapCells();
+  if (outflow_value_.extent(0) != std::size_t(cells) || outflow_value_.extent(2) < std::size_t(q.total)) {
+    outflow_value_ = WorkView("advection outflow value", cells, 2 * Dim, q.total);
+    bounds_ = WorkView("advection bounds", cells, q.total, 2);
+  }
   const auto outflow_mass = outflow_mass_;
   const auto outflow_value = outflow_value_;
+  const auto bounds = bounds_;
   const int materials = materials_;
 
   // The same for q, whose slabs weigh their mass F_f: the limited profile keeps q within its block
   // bounds in the slabs and in the mass left behind, so the new q is a mass-weighted mean of values
-  // within bounds (compatible fluxes).
+  // within bounds (compatible fluxes). The slab geometry and the mass left behind depend on the
+  // cell and material only: computed once for all columns.
   Kokkos::parallel_for(
-      "advection quantity slabs", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->overlapCells() * materials),
-      KOKKOS_LAMBDA(int i) {
-        const int c = i / materials, m = i % materials, col = m * components + component;
-        double g[Dim], spread = 0;
-        for (int d = 0; d < Dim; ++d) {
-          g[d] = stencil.gradient(Q, c, col, d);
-          spread += 0.5 * (g[d] < 0 ? -g[d] : g[d]) * stencil.spacing[d];
+      "advection quantity slabs", Kokkos::RangePolicy<ExecutionSpace>(0, cells), KOKKOS_LAMBDA(int c) {
+        for (int m = 0; m < materials; ++m) {
+          double fraction[2 * Dim], r[2 * Dim][Dim];
+          slabs.cellSlabs(c, m, fraction, r);
+          double remaining = M(c, m);
+          for (int f = 0; f < 2 * Dim; ++f) remaining -= outflow_mass(c, f, m);
+          if (!(remaining > 0)) remaining = 0.0;
+          for (int field = 0; field < q.fields; ++field) {
+            const auto& Q = q.field[field];
+            for (int j = 0; j < q.width[field]; ++j) {
+              const int col = m * q.width[field] + j, slot = q.first[field] + col;
+              double g[Dim], spread = 0;
+              for (int d = 0; d < Dim; ++d) {
+                g[d] = stencil.gradient(Q, c, col, d);
+                spread += 0.5 * (g[d] < 0 ? -g[d] : g[d]) * stencil.spacing[d];
+              }
+              double slope[2 * Dim];
+              double S = 0.0;
+              for (int f = 0; f < 2 * Dim; ++f) {
+                slope[f] = 0;
+                for (int d = 0; d < Dim; ++d) slope[f] += g[d] * r[f][d];
+                S += outflow_mass(c, f, m) * slope[f];
+              }
+              double lo, hi;
+              stencil.blockBounds(Q, c, col, lo, hi);
+              const double value = Q(c, col);
+              const double phi = limiter(value, lo, hi, spread, remaining, S);
+              for (int f = 0; f < 2 * Dim; ++f) outflow_value(c, f, slot) = value + phi * slope[f];
+              bounds(c, slot, 0) = lo;
+              bounds(c, slot, 1) = hi;
+            }
+          }
         }
-        double slope[2 * Dim];
-        double remaining = M(c, m), S = 0.0;
-        for (int f = 0; f < 2 * Dim; ++f) {
-          double r[Dim];
-          slabs.centroidOffset(c, f, m, slabs.outflowFraction(c, f, m), r);
-          slope[f] = 0;
-          for (int d = 0; d < Dim; ++d) slope[f] += g[d] * r[d];
-          remaining -= outflow_mass(c, f, m);
-          S += outflow_mass(c, f, m) * slope[f];
-        }
-        double lo, hi;
-        stencil.blockBounds(Q, c, col, lo, hi);
-        const double value = Q(c, col);
-        const double phi = limiter(value, lo, hi, spread, remaining > 0 ? remaining : 0.0, S);
-        for (int f = 0; f < 2 * Dim; ++f) outflow_value(c, f, m) = value + phi * slope[f];
       });
 }
 
 template <int Dim>
-void Advector<Dim>::computeNewMass(const Field<Dim>& mass)
+void Advector<Dim>::update(Field<Dim>& mass, const std::vector<Field<Dim>*>& mass_specific)
 {
-  const auto neighbours = layout_->cellNeighbours();
-  const auto outflow_mass = outflow_mass_;
-  const auto new_mass = new_mass_;
-  const auto M = mass.view();
-  const int materials = materials_;
-  // Each face's flux is one stored number, read by the donor (out) and by the receiver (in).
-  Kokkos::parallel_for(
-      "advection new mass", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells() * materials),
-      KOKKOS_LAMBDA(int i) {
-        const int c = i / materials, m = i % materials;
-        double value = M(c, m);
-        for (int f = 0; f < 2 * Dim; ++f) {
-          const LocalOrdinal n = neighbours(c, f);
-          const double in = n >= 0 ? outflow_mass(n, f ^ 1, m) : 0.0;
-          value += in - outflow_mass(c, f, m);
-        }
-        new_mass(c, m) = value;
-      });
-}
-
-template <int Dim>
-void Advector<Dim>::writeNewMass(Field<Dim>& mass)
-{
-  const auto new_mass = new_mass_;
-  auto M = mass.view();
-  const int materials = materials_;
-  Kokkos::parallel_for(
-      "advection write mass", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells() * materials),
-      KOKKOS_LAMBDA(int i) { M(i / materials, i % materials) = new_mass(i / materials, i % materials); });
-}
-
-template <int Dim>
-void Advector<Dim>::updateQuantity(Field<Dim>& quantity, int components, int component)
-{
-  const CellStencil<Dim> stencil(*layout_);
   const auto neighbours = layout_->cellNeighbours();
   const auto outflow_mass = outflow_mass_;
   const auto outflow_value = outflow_value_;
-  const auto new_mass = new_mass_;
-  const auto new_value = new_value_;
+  const auto bounds = bounds_;
+  const auto q = quantityColumns<Dim, kMaxFields, typename Field<Dim>::View>(mass_specific, materials_);
+  auto M = mass.view();
   const int materials = materials_;
-  const int entries = layout_->ownedCells() * materials;
-  const auto Q = static_cast<const Field<Dim>&>(quantity).view();
 
-  // (M q)_new = M q - Σ_out F q_out + Σ_in F q_in, written as an increment of q so that zero flux
-  // or a uniform q leaves q exactly unchanged:  q_new = q + Σ_f ±F_f (q_f - q) / M_new.
+  // Each face's flux is one stored number, read by the donor (out) and by the receiver (in). Per
+  // column, (M q)_new = M q - Σ_out F q_out + Σ_in F q_in, written as an increment of q so that zero
+  // flux or a uniform q leaves q exactly unchanged:  q_new = q + Σ_f ±F_f (q_f - q) / M_new.
+  // Cell c's entries are read and written by its own iteration only, so the update is in place.
   Kokkos::parallel_for(
-      "advection quantity update", Kokkos::RangePolicy<ExecutionSpace>(0, entries), KOKKOS_LAMBDA(int i) {
-        const int c = i / materials, m = i % materials, col = m * components + component;
-        const double q = Q(c, col);
-        double lo, hi;
-        stencil.blockBounds(Q, c, col, lo, hi);
-        double change = 0;
-        for (int f = 0; f < 2 * Dim; ++f) {
-          change -= outflow_mass(c, f, m) * (outflow_value(c, f, m) - q);
-          const LocalOrdinal n = neighbours(c, f);
-          if (n < 0) continue;
-          const double in = outflow_mass(n, f ^ 1, m);
-          if (in == 0) continue;
-          const double q_in = outflow_value(n, f ^ 1, m);
-          change += in * (q_in - q);
-          lo = q_in < lo ? q_in : lo;
-          hi = q_in > hi ? q_in : hi;
+      "advection update", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()), KOKKOS_LAMBDA(int c) {
+        for (int m = 0; m < materials; ++m) {
+          double mass_new = M(c, m);
+          for (int f = 0; f < 2 * Dim; ++f) {
+            const LocalOrdinal n = neighbours(c, f);
+            const double in = n >= 0 ? outflow_mass(n, f ^ 1, m) : 0.0;
+            mass_new += in - outflow_mass(c, f, m);
+          }
+          for (int field = 0; field < q.fields; ++field) {
+            const auto& Q = q.field[field];
+            for (int j = 0; j < q.width[field]; ++j) {
+              const int col = m * q.width[field] + j, slot = q.first[field] + col;
+              const double value_old = Q(c, col);
+              double lo = bounds(c, slot, 0), hi = bounds(c, slot, 1);
+              double change = 0;
+              for (int f = 0; f < 2 * Dim; ++f) {
+                change -= outflow_mass(c, f, m) * (outflow_value(c, f, slot) - value_old);
+                const LocalOrdinal n = neighbours(c, f);
+                if (n < 0) continue;
+                const double in = outflow_mass(n, f ^ 1, m);
+                if (in == 0) continue;
+                const double q_in = outflow_value(n, f ^ 1, slot);
+                change += in * (q_in - value_old);
+                lo = q_in < lo ? q_in : lo;
+                hi = q_in > hi ? q_in : hi;
+              }
+              double value = mass_new > 0 ? value_old + change / mass_new : value_old;
+              // In exact arithmetic the new q is a mean of the remainder (within [lo, hi] of the
+              // block) and the inflow values, so this only removes round-off, which is large relative
+              // to q only where nearly all the mass has left (then M_new·q is tiny either way).
+              Q(c, col) = value < lo ? lo : (value > hi ? hi : value);
+            }
+          }
+          M(c, m) = mass_new;
         }
-        const double mass_new = new_mass(c, m);
-        double value = mass_new > 0 ? q + change / mass_new : q;
-        // In exact arithmetic the new q is a mean of the remainder (within [lo, hi] of the block)
-        // and the inflow values, so this only removes round-off, which is large relative to q
-        // only where nearly all the mass has left (then M_new·q is tiny either way).
-        value = value < lo ? lo : (value > hi ? hi : value);
-        new_value(c, m) = value;
-      });
-  auto Q_out = quantity.view();
-  Kokkos::parallel_for(
-      "advection write quantity", Kokkos::RangePolicy<ExecutionSpace>(0, entries), KOKKOS_LAMBDA(int i) {
-        Q_out(i / materials, (i % materials) * components + component) = new_value(i / materials, i % materials);
       });
 }
 

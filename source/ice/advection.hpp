@@ -70,22 +70,28 @@ class Advector {
 
   using WorkView = Kokkos::View<double***, MemorySpace>;  // (local cell, face, material)
 
+ /// At most this many mass-specific fields per advect() call (each of any width).
+  static constexpr int kMaxFields = 8;
+
  private:
   void reconstructMass(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass);
-  void reconstructQuantity(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass,
-                           const Field<Dim>& quantity, int components, int component);
-  void computeNewMass(const Field<Dim>& mass);
-  void updateQuantity(Field<Dim>& quantity, int components, int component);
-  void writeNewMass(Field<Dim>& mass);
+  void reconstructQuantities(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass,
+                             const std::vector<Field<Dim>*>& mass_specific);
+  void update(Field<Dim>& mass, const std::vector<Field<Dim>*>& mass_specific);
 
   std::shared_ptr<const Layout<Dim>> layout_;
   int materials_;
   Options options_;
+  // Per local cell: the local ids of its 3^Dim block (itself included), < 0 where there is none
+  // held by this rank; built once, read by the limiter bounds.
+  Kokkos::View<LocalOrdinal**, MemorySpace> block_;
   // Per local cell (owned and ghost), face f = 2 d + side and material: the mass leaving the cell
-  // through f in this step (>= 0), and the value of the quantity being advected in that slab.
-  WorkView outflow_mass_, outflow_value_;
-  // Per owned cell and material: the new mass (written last) and the new value of one column.
-  Kokkos::View<double**, MemorySpace> new_mass_, new_value_;
+  // through f in this step (>= 0).
+  WorkView outflow_mass_;
+  // Per local cell, face and quantity column (all fields' columns side by side): the value of the
+  // quantity in the outflow slab; and per local cell and column, the block bounds [lo, hi] of the
+  // quantity (computed once for the limiter, reused by the update's final bound).
+  WorkView outflow_value_, bounds_;
 };
 
 extern template class Advector<2>;

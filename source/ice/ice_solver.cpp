@@ -98,6 +98,7 @@ IceSettings IceSettings::fromScene(const Scene& scene)
   s.outer_tolerance = number(ice, "outer_tolerance", s.outer_tolerance);
   if (!(s.outer_tolerance > 0))
     throw inputError("cfdmpm.ice.outer_tolerance", std::to_string(s.outer_tolerance), "must be > 0 (1/s)");
+  s.solver_tolerance_given = ice.isParameter("solver_tolerance");
   s.solver_tolerance = number(ice, "solver_tolerance", s.solver_tolerance);
   if (!(s.solver_tolerance > 0 && s.solver_tolerance < 1e-2))
     throw inputError("cfdmpm.ice.solver_tolerance", std::to_string(s.solver_tolerance), "must be in (0, 0.01)");
@@ -106,10 +107,14 @@ IceSettings IceSettings::fromScene(const Scene& scene)
     throw inputError("cfdmpm.ice.dt_growth", std::to_string(s.dt_growth), "must be > 1");
   if (ice.isSublist("linear_solver")) s.linear_solver = ice.sublist("linear_solver");
   s.linear_solver.set("tolerance", s.solver_tolerance);
-  // The pressure matrix changes little from step to step: a full MueLu set-up every 10 solves
-  // (symbolic reuse in between) halves the pressure phase of the dam break at 280k cells with the
-  // same CG iteration count (bench/bench_ice).
-  if (!s.linear_solver.isParameter("reuse interval")) s.linear_solver.set("reuse interval", 10);
+  // The pressure matrix changes little from step to step: between full MueLu set-ups (every 50
+  // solves, or sooner when a reused hierarchy needs 1.5 times the iterations per decade of a fresh
+  // one) only the finest level's smoother is recomputed ("RAP"). On the dam break at 280k cells
+  // this costs a third of a set-up every 10 solves with RP reuse, at the same CG iteration count
+  // (bench/bench_ice, doc/ice-pressure.md).
+  if (!s.linear_solver.isParameter("reuse interval")) s.linear_solver.set("reuse interval", 50);
+  if (!s.linear_solver.isParameter("reuse mode")) s.linear_solver.set("reuse mode", std::string("RAP"));
+  if (!s.linear_solver.isParameter("reuse slowdown limit")) s.linear_solver.set("reuse slowdown limit", 1.5);
   return s;
 }
 
@@ -539,7 +544,16 @@ IceStepReport IceSolver<Dim>::step(CellState<Dim>& state, double dt)
     ++report.outer_iterations;
     if (implicit) {
       delta_p_.fill(0.0);
-      const PressureSolveReport solve = pressure_solver_->solve(rhs_, delta_p_);
+      // After this solve the right-hand side is the linear residual r plus the change of the
+      // upwinded fluxes (the matrix uses mean face volume fractions). The outer test bounds
+      // max_c |rhs_c| / V and max_c |r_c| <= ||r||_2, so a residual of 2-norm below a tenth of
+      // outer_tolerance V can never be what keeps the outer test from passing; solving further only
+      // polishes digits that the next right-hand side replaces. An explicit solver_tolerance is
+      // honoured as given (e.g. tight solves to compare decompositions).
+      const double residual_target = settings_.solver_tolerance_given
+                                         ? 0.0
+                                         : 0.1 * settings_.outer_tolerance * layout_->grid().cellVolume();
+      const PressureSolveReport solve = pressure_solver_->solve(rhs_, delta_p_, residual_target);
       report.linear_iterations += solve.iterations;
       if (!solve.converged)
         throw std::runtime_error("ice: pressure solve did not converge (relative residual " +

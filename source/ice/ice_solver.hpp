@@ -37,7 +37,8 @@ struct IceSettings {
   double exchange_coefficient = 1e15;    // momentum exchange K between every pair (kg/(m^3 s))
   int max_outer_iterations = 20;
   double outer_tolerance = 1e-8;         // on max |rhs| / V_cell of the pressure equation
-  double solver_tolerance = 1e-10;       // relative residual of each linear solve
+  double solver_tolerance = 1e-10;       // relative residual of each linear solve (when given)
+  bool solver_tolerance_given = false;   // false: each solve goes as far as the outer test needs
   double dt_growth = 1.2;                // largest ratio of successive time steps
   Teuchos::ParameterList linear_solver;  // passed to PressureSolver
 

@@ -9,10 +9,12 @@
 #include <BelosTpetraAdapter.hpp>
 #include <MueLu_CreateTpetraPreconditioner.hpp>
 #include <Teuchos_CommHelpers.hpp>
+#include <Teuchos_TimeMonitor.hpp>
 #include <Tpetra_CrsGraph.hpp>
 #include <Tpetra_CrsMatrix.hpp>
 #include <Tpetra_Vector.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -33,7 +35,7 @@ using MueLuPreconditioner = MueLu::TpetraOperator<Scalar, LocalOrdinal, GlobalOr
 using Clock = std::chrono::steady_clock;
 
 enum class PreconditionerType { MueLu, Jacobi, None };
-enum class ReuseMode { KeepRP, KeepTentativeP, Frozen };
+enum class ReuseMode { KeepRAP, KeepRP, KeepTentativeP, Frozen };
 
 double secondsSince(Clock::time_point start)
 {
@@ -48,6 +50,7 @@ struct Settings {
   int verbosity = 0;
   int reuse_interval = 1;
   ReuseMode reuse_mode = ReuseMode::KeepRP;
+  double reuse_slowdown_limit = 0;  // 0: off
 };
 
 Settings readSettings(Teuchos::ParameterList& list, const Teuchos::ParameterList& valid)
@@ -77,10 +80,15 @@ Settings readSettings(Teuchos::ParameterList& list, const Teuchos::ParameterList
   if (s.reuse_interval < 1)
     throw inputError("pressure solver: reuse interval", std::to_string(s.reuse_interval), "must be >= 1");
   const std::string mode = list.get<std::string>("reuse mode");
-  if (mode == "RP") s.reuse_mode = ReuseMode::KeepRP;
+  if (mode == "RAP") s.reuse_mode = ReuseMode::KeepRAP;
+  else if (mode == "RP") s.reuse_mode = ReuseMode::KeepRP;
   else if (mode == "tP") s.reuse_mode = ReuseMode::KeepTentativeP;
   else if (mode == "frozen") s.reuse_mode = ReuseMode::Frozen;
-  else throw inputError("pressure solver: reuse mode", mode, "allowed: RP, tP, frozen");
+  else throw inputError("pressure solver: reuse mode", mode, "allowed: RAP, RP, tP, frozen");
+  s.reuse_slowdown_limit = list.get<double>("reuse slowdown limit");
+  if (!(s.reuse_slowdown_limit == 0 || s.reuse_slowdown_limit >= 1))
+    throw inputError("pressure solver: reuse slowdown limit", std::to_string(s.reuse_slowdown_limit),
+                     "must be 0 (off) or >= 1");
   return s;
 }
 
@@ -134,10 +142,18 @@ struct PressureSolver<Dim>::Impl {
   Settings settings;
 
   Teuchos::RCP<CrsMatrix> matrix;
-  // (owned cell, slot) -> local column id in the matrix's column map; -1 across a wall.
-  Kokkos::View<LocalOrdinal**, MemorySpace> stencil_columns;
-  typename Kokkos::View<LocalOrdinal**, MemorySpace>::HostMirror stencil_columns_host;
-  Kokkos::View<Scalar**, MemorySpace> stencil_values;  // same shape; filled by assemble()
+  // (owned cell, slot) -> position of that entry in the local CRS values array; -1 across a wall.
+  // assemble() writes the values there directly: the graph and its maps never change.
+  Kokkos::View<std::size_t**, MemorySpace> stencil_offsets;
+  static constexpr std::size_t kNoEntry = ~std::size_t(0);
+
+  // Work vectors of solve(), allocated once (a residual and the caller's guess).
+  Teuchos::RCP<MultiVector> residual, guess;
+
+  // Cumulative wall time of the parts of the solve, for profiling (bench/bench_ice).
+  Teuchos::RCP<Teuchos::Time> assemble_timer = Teuchos::TimeMonitor::getNewCounter("pressure solver: assemble");
+  Teuchos::RCP<Teuchos::Time> setup_timer = Teuchos::TimeMonitor::getNewCounter("pressure solver: preconditioner");
+  Teuchos::RCP<Teuchos::Time> cg_timer = Teuchos::TimeMonitor::getNewCounter("pressure solver: CG");
 
   Teuchos::RCP<MueLuPreconditioner> muelu;
   Teuchos::RCP<InverseDiagonal> jacobi;
@@ -145,13 +161,16 @@ struct PressureSolver<Dim>::Impl {
   bool values_changed = false;  // since the preconditioner last saw the matrix
   bool rebuild_requested = false;
   int solves_since_setup = 0;
+  // CG iterations per decade of residual reduction of the last solve with a fresh hierarchy (0:
+  // none yet); a reused hierarchy that needs `reuse slowdown limit` times more is replaced.
+  double fresh_iterations_per_decade = 0;
 
   void buildGraph();
   Teuchos::ParameterList mueluParameters() const;
   Teuchos::RCP<Operator> preparePreconditioner(PressureSolveReport& report);
   double residualNorm(const MultiVector& b, const MultiVector& x) const;
   void runCG(const Teuchos::RCP<Operator>& preconditioner, const MultiVector& b, MultiVector& x, double b_norm,
-             PressureSolveReport& report) const;
+             double tolerance, PressureSolveReport& report) const;
 };
 
 template <int Dim>
@@ -191,16 +210,22 @@ void PressureSolver<Dim>::Impl::buildGraph()
   }
   graph->fillComplete(rows, rows);
 
+  // Where each stencil entry sits in the local CRS arrays (the graph sorts a row's columns).
   const Map& column_map = *graph->getColMap();
-  stencil_columns = Kokkos::View<LocalOrdinal**, MemorySpace>("pressure stencil columns", owned, kStencil);
-  stencil_columns_host = Kokkos::create_mirror_view(stencil_columns);
+  const auto local_graph = graph->getLocalGraphHost();
+  stencil_offsets = Kokkos::View<std::size_t**, MemorySpace>("pressure stencil offsets", owned, kStencil);
+  const auto offsets_host = Kokkos::create_mirror_view(stencil_offsets);
   for (LocalOrdinal c = 0; c < owned; ++c)
     for (int s = 0; s < kStencil; ++s) {
       const GlobalOrdinal gid = stencil_gids[c * kStencil + s];
-      stencil_columns_host(c, s) = gid < 0 ? -1 : column_map.getLocalElement(gid);
+      offsets_host(c, s) = kNoEntry;
+      if (gid < 0) continue;
+      const LocalOrdinal column = column_map.getLocalElement(gid);
+      for (auto k = local_graph.row_map(c); k < local_graph.row_map(c + 1); ++k)
+        if (local_graph.entries(k) == column) offsets_host(c, s) = k;
+      if (offsets_host(c, s) == kNoEntry) throw std::logic_error("PressureSolver: stencil entry missing from the graph");
     }
-  Kokkos::deep_copy(stencil_columns, stencil_columns_host);
-  stencil_values = Kokkos::View<Scalar**, MemorySpace>("pressure stencil values", owned, kStencil);
+  Kokkos::deep_copy(stencil_offsets, offsets_host);
 
   matrix = Teuchos::rcp(new CrsMatrix(graph));
   matrix->fillComplete(rows, rows);  // all zeros until the first assemble()
@@ -217,8 +242,12 @@ Teuchos::ParameterList PressureSolver<Dim>::Impl::mueluParameters() const
   // MueLu's default coarse solver (Amesos2 KLU2) diverges on more than one rank with Debian's
   // Trilinos 13.2 (the coarse matrix stays distributed); ILUT on the coarse level works.
   if (layout->comm()->getSize() > 1) p.set("coarse: type", std::string("ILUT"));
-  if (settings.reuse_interval > 1 && settings.reuse_mode != ReuseMode::Frozen)
-    p.set("reuse: type", std::string(settings.reuse_mode == ReuseMode::KeepRP ? "RP" : "tP"));
+  if (settings.reuse_interval > 1 && settings.reuse_mode != ReuseMode::Frozen) {
+    const char* type = settings.reuse_mode == ReuseMode::KeepRAP  ? "RAP"
+                       : settings.reuse_mode == ReuseMode::KeepRP ? "RP"
+                                                                  : "tP";
+    p.set("reuse: type", std::string(type));
+  }
   p.setParameters(settings_list.sublist("muelu"));  // the user's MueLu keys win
   return p;
 }
@@ -246,8 +275,9 @@ Teuchos::RCP<Operator> PressureSolver<Dim>::Impl::preparePreconditioner(Pressure
     rebuild_requested = false;
     report.preconditioner_rebuilt = true;
   } else if (values_changed && settings.reuse_mode != ReuseMode::Frozen) {
-    // Keep the aggregates and the transfer operators (RP) or the tentative prolongator only (tP);
-    // recompute the rest (smoothed prolongators for tP, coarse matrices, smoothers).
+    // Keep the coarse levels and recompute the finest level's smoother only (RAP), keep the
+    // aggregates and the transfer operators (RP) or the tentative prolongator only (tP); recompute
+    // the rest (smoothed prolongators for tP, coarse matrices, smoothers).
     MueLu::ReuseTpetraPreconditioner(matrix, *muelu);
   }
   // Frozen: the hierarchy built for older values is applied as it is (its finest level sees the
@@ -259,7 +289,8 @@ Teuchos::RCP<Operator> PressureSolver<Dim>::Impl::preparePreconditioner(Pressure
 template <int Dim>
 double PressureSolver<Dim>::Impl::residualNorm(const MultiVector& b, const MultiVector& x) const
 {
-  MultiVector r(b, Teuchos::Copy);
+  MultiVector& r = *residual;
+  r.assign(b);
   matrix->apply(x, r, Teuchos::NO_TRANS, -1.0, 1.0);  // r = b - A x
   double norm = 0;
   r.norm2(Teuchos::ArrayView<double>(&norm, 1));
@@ -271,7 +302,8 @@ double PressureSolver<Dim>::Impl::residualNorm(const MultiVector& b, const Multi
 /// current iterate (a restart recomputes the residual), at most twice, within the iteration budget.
 template <int Dim>
 void PressureSolver<Dim>::Impl::runCG(const Teuchos::RCP<Operator>& preconditioner, const MultiVector& b,
-                                      MultiVector& x, double b_norm, PressureSolveReport& report) const
+                                      MultiVector& x, double b_norm, double tolerance,
+                                      PressureSolveReport& report) const
 {
   auto problem = Teuchos::rcp(new Belos::LinearProblem<Scalar, MultiVector, Operator>(
       matrix, Teuchos::rcpFromRef(x), Teuchos::rcpFromRef(b)));
@@ -281,7 +313,7 @@ void PressureSolver<Dim>::Impl::runCG(const Teuchos::RCP<Operator>& precondition
   int iterations = 0;
   for (int attempt = 0; attempt < 3; ++attempt) {
     auto belos = Teuchos::rcp(new Teuchos::ParameterList);
-    belos->set("Convergence Tolerance", settings.tolerance);
+    belos->set("Convergence Tolerance", tolerance);
     belos->set("Maximum Iterations", settings.maximum_iterations - iterations);
     belos->set("Implicit Residual Scaling", std::string("Norm of RHS"));  // relative to ||b||, not ||r0||
     belos->set("Verbosity", verbosity);
@@ -297,7 +329,7 @@ void PressureSolver<Dim>::Impl::runCG(const Teuchos::RCP<Operator>& precondition
     }
     iterations += cg.getNumIters();
     report.relative_residual = residualNorm(b, x) / b_norm;
-    report.converged = report.relative_residual <= settings.tolerance;
+    report.converged = report.relative_residual <= tolerance;
     if (report.converged || result != Belos::Converged || iterations >= settings.maximum_iterations) break;
   }
   report.iterations += iterations;
@@ -329,7 +361,11 @@ Teuchos::RCP<const Teuchos::ParameterList> PressureSolver<Dim>::validParameters(
   p->set("reuse interval", 1, "a full MueLu setup every N solves (1: every solve)");
   p->set("reuse mode", std::string("RP"),
          "between full setups: RP keeps aggregates, prolongators and restrictions and recomputes the coarse "
-         "matrices and smoothers; tP keeps the tentative prolongator only; frozen reuses the old hierarchy");
+         "matrices and smoothers; tP keeps the tentative prolongator only; RAP keeps the coarse levels and "
+         "recomputes the finest level's smoother; frozen reuses the old hierarchy");
+  p->set("reuse slowdown limit", 0.0,
+         "0: off; else a full MueLu setup follows a solve whose reused hierarchy needed more than this factor "
+         "times the CG iterations per decade of residual reduction of the last fresh hierarchy");
   p->sublist("muelu", false, "MueLu parameters applied on top of cfdmpm's defaults");
   return p;
 }
@@ -369,6 +405,7 @@ void PressureSolver<Dim>::assemble(const Field<Dim>& mixture_compressibility, Fa
     requireOneColumn(face_coefficient.direction(d).columns(), face_coefficient.direction(d).name(), "face coefficient");
   if (!(dt > 0 && std::isfinite(dt))) throw std::invalid_argument("PressureSolver: dt must be > 0, got " + std::to_string(dt));
 
+  Teuchos::TimeMonitor timer(*m.assemble_timer);
   // The upper face of an owned cell is the lower face of its neighbour, possibly a ghost.
   face_coefficient.exchangeHalo();
 
@@ -382,7 +419,9 @@ void PressureSolver<Dim>::assemble(const Field<Dim>& mixture_compressibility, Fa
   LowerFaceValues<Dim> beta;
   for (int d = 0; d < Dim; ++d) beta.direction[d] = face_coefficient.direction(d).view();
   const auto neighbours = lay.cellNeighbours();
-  const auto values = m.stencil_values;
+  // The matrix's own values array (Serial: host memory; the graph is fixed, so no fill is resumed).
+  const auto values = m.matrix->getLocalMatrixDevice().values;
+  const auto offsets = m.stencil_offsets;
   const LocalOrdinal owned = lay.ownedCells();
 
   // The first owned cell with a bad coefficient (owned when there is none).
@@ -395,18 +434,15 @@ void PressureSolver<Dim>::assemble(const Field<Dim>& mixture_compressibility, Fa
         bool ok = kappa(c, 0) > 0 && kappa(c, 0) < INFINITY;
         for (int f = 0; f < 2 * Dim; ++f) {
           const LocalOrdinal n = neighbours(c, f);
-          if (n < 0) {  // wall: zero normal gradient, no flux
-            values(c, 1 + f) = 0;
-            continue;
-          }
+          if (n < 0) continue;  // wall: zero normal gradient, no flux, no entry
           const int d = f / 2;
           const double b = beta(d, f % 2 == 0 ? c : n);  // lower face of c, or of the upper neighbour
           ok = ok && b >= 0 && b < INFINITY;
           const double a = weight[d] * b;
-          values(c, 1 + f) = -a;
+          values(offsets(c, 1 + f)) = -a;
           diagonal += a;
         }
-        values(c, 0) = diagonal;
+        values(offsets(c, 0)) = diagonal;
         if (!ok && c < bad) bad = c;
       },
       Kokkos::Min<LocalOrdinal>(first_bad));
@@ -415,6 +451,7 @@ void PressureSolver<Dim>::assemble(const Field<Dim>& mixture_compressibility, Fa
   int local_bad = first_bad < owned ? 1 : 0, any_bad = 0;
   Teuchos::reduceAll(*lay.comm(), Teuchos::REDUCE_MAX, local_bad, Teuchos::outArg(any_bad));
   if (any_bad) {
+    m.assembled = false;  // the values are partly overwritten: no solve with this matrix
     std::ostringstream message;
     message << "PressureSolver::assemble: ";
     if (local_bad) {
@@ -427,28 +464,6 @@ void PressureSolver<Dim>::assemble(const Field<Dim>& mixture_compressibility, Fa
     throw std::runtime_error(message.str());
   }
 
-  // Replace the values in the fixed graph.
-  const auto values_host = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), values);
-  const auto& columns = m.stencil_columns_host;
-  m.matrix->resumeFill();
-  long long replaced = 0, expected = 0;
-  for (LocalOrdinal c = 0; c < owned; ++c) {
-    LocalOrdinal row_columns[Impl::kStencil];
-    Scalar row_values[Impl::kStencil];
-    LocalOrdinal n = 0;
-    for (int s = 0; s < Impl::kStencil; ++s)
-      if (columns(c, s) >= 0) {
-        row_columns[n] = columns(c, s);
-        row_values[n] = values_host(c, s);
-        ++n;
-      }
-    replaced += m.matrix->replaceLocalValues(c, n, row_values, row_columns);
-    expected += n;
-  }
-  m.matrix->fillComplete(lay.ownedCellMap(), lay.ownedCellMap());
-  if (replaced != expected)
-    throw std::logic_error("PressureSolver::assemble: replaced " + std::to_string(replaced) + " of " +
-                           std::to_string(expected) + " matrix entries");
   m.assembled = true;
   m.values_changed = true;
 }
@@ -463,12 +478,13 @@ void PressureSolver<Dim>::apply(const Field<Dim>& x, Field<Dim>& y) const
 }
 
 template <int Dim>
-PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>& solution)
+PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>& solution, double residual_target)
 {
   Impl& m = *impl_;
   if (!m.assembled) throw std::logic_error("PressureSolver::solve before assemble");
   requireOneColumn(rhs.columns(), rhs.name(), "rhs");
   requireOneColumn(solution.columns(), solution.name(), "solution");
+  if (!(residual_target >= 0)) throw std::invalid_argument("PressureSolver::solve: residual target must be >= 0");
   const Settings& s = m.settings;
   PressureSolveReport report;
 
@@ -482,17 +498,31 @@ PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>
     report.converged = true;
     return report;
   }
+  // The relative tolerance of this solve: the settings' one, or looser when the caller's absolute
+  // target allows it (never looser than 0.5: CG must reduce the residual at all).
+  report.tolerance = std::min(std::max(s.tolerance, residual_target / b_norm), 0.5);
+  if (m.residual.is_null()) {
+    m.residual = Teuchos::rcp(new MultiVector(b.getMap(), 1, false));
+    m.guess = Teuchos::rcp(new MultiVector(b.getMap(), 1, false));
+  }
 
   // 1. Preconditioner: built, refreshed or reused.
   Clock::time_point start = Clock::now();
-  Teuchos::RCP<Operator> preconditioner = m.preparePreconditioner(report);
+  Teuchos::RCP<Operator> preconditioner;
+  {
+    Teuchos::TimeMonitor timer(*m.setup_timer);
+    preconditioner = m.preparePreconditioner(report);
+  }
   report.setup_seconds = secondsSince(start);
   const bool reused = s.preconditioner == PreconditionerType::MueLu && !report.preconditioner_rebuilt;
-  const Teuchos::RCP<MultiVector> guess = reused ? Teuchos::rcp(new MultiVector(x, Teuchos::Copy)) : Teuchos::null;
+  if (reused) m.guess->assign(x);
 
   // 2. CG from the caller's guess.
   start = Clock::now();
-  m.runCG(preconditioner, b, x, b_norm, report);
+  {
+    Teuchos::TimeMonitor timer(*m.cg_timer);
+    m.runCG(preconditioner, b, x, b_norm, report.tolerance, report);
+  }
   report.solve_seconds = secondsSince(start);
 
   // 3. A reused hierarchy may no longer suit the matrix (a frozen Chebyshev smoother that meets
@@ -501,21 +531,41 @@ PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>
   if (!report.converged && reused) {
     m.rebuild_requested = true;
     start = Clock::now();
-    preconditioner = m.preparePreconditioner(report);
+    {
+      Teuchos::TimeMonitor timer(*m.setup_timer);
+      preconditioner = m.preparePreconditioner(report);
+    }
     report.setup_seconds += secondsSince(start);
     start = Clock::now();
-    x.assign(*guess);
+    x.assign(*m.guess);
     report.failure.clear();
-    m.runCG(preconditioner, b, x, b_norm, report);
+    {
+      Teuchos::TimeMonitor timer(*m.cg_timer);
+      m.runCG(preconditioner, b, x, b_norm, report.tolerance, report);
+    }
     report.solve_seconds += secondsSince(start);
   }
   solution.exchangeHalo();
   ++m.solves_since_setup;
 
+  // 4. Has the reused hierarchy grown stale? Compare the iterations per decade of reduction of
+  //    ||rhs − A x|| / ||rhs|| with those of the last fresh hierarchy (the caller's guess counts as
+  //    no better than zero, so a good guess can only make a reused hierarchy look better).
+  if (s.preconditioner == PreconditionerType::MueLu && report.converged && report.iterations > 0 &&
+      report.relative_residual > 0 && report.relative_residual < 0.1) {
+    const double per_decade = report.iterations / -std::log10(report.relative_residual);
+    // (After a failed reuse the count includes the failed attempt: no reference until the next setup.)
+    if (report.preconditioner_rebuilt) m.fresh_iterations_per_decade = reused ? 0.0 : per_decade;
+    else if (s.reuse_slowdown_limit > 0 && m.fresh_iterations_per_decade > 0 &&
+             per_decade > s.reuse_slowdown_limit * m.fresh_iterations_per_decade)
+      m.rebuild_requested = true;
+  }
+
   if (s.verbosity >= 1 && m.layout->comm()->getRank() == 0) {
     std::cout << "pressure solve: " << report.iterations << " CG iterations, relative residual "
-              << std::scientific << std::setprecision(2) << report.relative_residual << std::defaultfloat
-              << (report.converged ? "" : " (NOT CONVERGED)") << ", setup " << report.setup_seconds << " s"
+              << std::scientific << std::setprecision(2) << report.relative_residual << " (tolerance "
+              << report.tolerance << ")" << std::defaultfloat << (report.converged ? "" : " (NOT CONVERGED)")
+              << ", setup " << report.setup_seconds << " s"
               << (report.preconditioner_rebuilt ? " (new preconditioner)" : "") << ", solve "
               << report.solve_seconds << " s\n";
   }

@@ -32,6 +32,7 @@ namespace cfdmpm {
 struct PressureSolveReport {
   int iterations = 0;                   // CG iterations, summed over restarts and a fallback setup
   double relative_residual = 0;         // true residual ||b − A x|| / ||b|| (0 when b = 0)
+  double tolerance = 0;                 // the relative tolerance this solve used (see solve())
   bool converged = false;
   bool preconditioner_rebuilt = false;  // a full MueLu setup happened in this solve (scheduled,
                                         // requested, or after a solve with a reused one failed)
@@ -58,8 +59,10 @@ class PressureSolver {
   ///   "tolerance" (1e-10, relative to ||rhs||), "maximum iterations" (500, per preconditioner),
   ///   "preconditioner" ("muelu" | "jacobi" | "none"), "verbosity" (0 quiet, 1 one line per solve,
   ///   2 plus Belos and MueLu output), "reuse interval" (1: a full MueLu setup every solve; N: every
-  ///   N solves), "reuse mode" ("RP" | "tP" | "frozen": what happens between full setups), and a
-  ///   sublist "muelu" passed to MueLu on top of cfdmpm's defaults.
+  ///   N solves), "reuse mode" ("RAP" | "RP" | "tP" | "frozen": what happens between full setups),
+  ///   "reuse slowdown limit" (0 off; else a full setup follows a reused solve that needed this
+  ///   factor more iterations per decade than the last fresh hierarchy), and a sublist "muelu"
+  ///   passed to MueLu on top of cfdmpm's defaults.
   static Teuchos::RCP<const Teuchos::ParameterList> validParameters();
   /// The settings in use, defaults filled in.
   const Teuchos::ParameterList& settings() const;
@@ -75,9 +78,12 @@ class PressureSolver {
 
   /// Solves A δp = rhs. `solution` holds the initial guess on entry (warm start) and the answer on
   /// return, with its ghost entries exchanged. Both fields have 1 column; owned rows of rhs are read.
+  /// CG stops when the true residual ||rhs − A δp||₂ is at most max(tolerance ||rhs||₂,
+  /// residual_target) (and at most 0.5 ||rhs||₂): a caller whose own convergence test needs no more
+  /// than an absolute residual (the ICE outer iteration) passes it as residual_target.
   /// Never throws for an unconverged solve: see the report. When a solve with a reused MueLu
   /// hierarchy fails, a fresh hierarchy is built and the solve repeated from the initial guess.
-  PressureSolveReport solve(const Field<Dim>& rhs, Field<Dim>& solution);
+  PressureSolveReport solve(const Field<Dim>& rhs, Field<Dim>& solution, double residual_target = 0);
 
   /// y = A x on the owned cells (x's ghosts are not read; y's ghosts are not written).
   void apply(const Field<Dim>& x, Field<Dim>& y) const;

@@ -604,6 +604,7 @@ TEST(PressureSolverBehaviour, PreconditionerReuseOverStepsConverges)
     std::string mode;
   };
   const std::vector<Variant> variants = {{"full setup every step", 1, "RP"},
+                                         {"reuse RAP, full setup every 6", interval, "RAP"},
                                          {"reuse RP, full setup every 6", interval, "RP"},
                                          {"reuse tP, full setup every 6", interval, "tP"},
                                          {"frozen, full setup every 6", interval, "frozen"}};

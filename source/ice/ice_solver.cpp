@@ -9,6 +9,7 @@
 #include <cfloat>
 #include <optional>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 
 namespace cfdmpm {
@@ -555,10 +556,15 @@ IceStepReport IceSolver<Dim>::step(CellState<Dim>& state, double dt)
                                          : 0.1 * settings_.outer_tolerance * layout_->grid().cellVolume();
       const PressureSolveReport solve = pressure_solver_->solve(rhs_, delta_p_, residual_target);
       report.linear_iterations += solve.iterations;
-      if (!solve.converged)
-        throw std::runtime_error("ice: pressure solve did not converge (relative residual " +
-                                 std::to_string(solve.relative_residual) + " after " +
-                                 std::to_string(solve.iterations) + " iterations)");
+      if (!solve.converged) {
+        std::ostringstream message;
+        message << std::scientific << std::setprecision(3) << "ice: pressure solve did not converge: relative residual "
+                << solve.relative_residual << " after " << solve.iterations << " CG iterations, tolerance "
+                << solve.tolerance;
+        if (!solve.failure.empty()) message << " (" << solve.failure << ")";
+        message << "; cfdmpm.ice.solver_tolerance below ~1e-13 can stall at round-off";
+        throw std::runtime_error(message.str());
+      }
     } else {
       // Explicit: δp = rhs / (V κ), faces not coupled through the pressure Laplacian.
       const auto rhs = rhs_.view();

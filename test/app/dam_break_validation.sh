@@ -8,7 +8,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 status=0
 for cells in "100, 40" "200, 80"; do
-  name=$(echo "$cells" | tr -d ' ,')
+  name=$(echo "$cells" | sed "s/, */x/")
   sed -e "s|directory: .*|directory: $work/$name|" -e "s|cells: \[200, 80\]|cells: [$cells]|" \
       "$SOURCE_DIR/input/dam-break.yaml" > "$work/$name.yaml"
   "$MPIEXEC" -n 2 "$CFDMPM" "$work/$name.yaml" > "$work/$name.log"

@@ -446,12 +446,20 @@ std::vector<std::string> materialNames(const std::vector<MaterialSpec>& material
   return names;
 }
 
+/// A fixed section of the root (no per-direction keys): its keys checked and its defaults filled in.
+ParameterList& checkedSection(ParameterList& list, const std::string& name)
+{
+  const std::string path = kRoot + "." + name;
+  const ParameterList& valid = validSceneParameters()->sublist(name);
+  checkKeys(list, valid, path, 0);
+  setDefaults(list, valid, path);
+  return list;
+}
+
 InitialStateSpec readInitialState(ParameterList& list, const std::vector<MaterialSpec>& materials)
 {
   const std::string path = kRoot + ".initial_state";
-  const ParameterList& valid = validSceneParameters()->sublist("initial_state");
-  checkKeys(list, valid, path, 0);
-  setDefaults(list, valid, path);
+  checkedSection(list, "initial_state");
 
   InitialStateSpec initial;
   initial.background_material = list.get<std::string>("background_material");
@@ -606,9 +614,7 @@ std::vector<BoundarySpec> readBoundaries(ParameterList& section, int dimension, 
 TimeSpec readTime(ParameterList& list)
 {
   const std::string path = kRoot + ".time";
-  const ParameterList& valid = validSceneParameters()->sublist("time");
-  checkKeys(list, valid, path, 0);
-  setDefaults(list, valid, path);
+  checkedSection(list, "time");
 
   TimeSpec time;
   time.end_time = list.get<double>("end_time");
@@ -630,10 +636,7 @@ TimeSpec readTime(ParameterList& list)
 
 MpmSpec readMpm(ParameterList& list)
 {
-  const std::string path = kRoot + ".mpm";
-  const ParameterList& valid = validSceneParameters()->sublist("mpm");
-  checkKeys(list, valid, path, 0);
-  setDefaults(list, valid, path);
+  checkedSection(list, "mpm");
   MpmSpec mpm;
   mpm.shape_function = list.get<std::string>("shape_function");
   mpm.flip_fraction = list.get<double>("flip_fraction");
@@ -648,9 +651,7 @@ MpmSpec readMpm(ParameterList& list)
 OutputSpec readOutput(ParameterList& list)
 {
   const std::string path = kRoot + ".output";
-  const ParameterList& valid = validSceneParameters()->sublist("output");
-  checkKeys(list, valid, path, 0);
-  setDefaults(list, valid, path);
+  checkedSection(list, "output");
 
   OutputSpec output;
   output.directory = list.get<std::string>("directory");

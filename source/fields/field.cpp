@@ -29,9 +29,19 @@ const Teuchos::RCP<const typename Layout<Dim>::Import>& Field<Dim>::importer() c
 }
 
 template <int Dim>
+bool Field<Dim>::selfOnly() const
+{
+  const auto& import = *importer();
+  return layout_->comm()->getSize() == 1 && import.getNumRemoteIDs() == 0 && import.getNumPermuteIDs() == 0 &&
+         import.getNumExportIDs() == 0;
+}
+
+template <int Dim>
 void Field<Dim>::exchangeHalo()
 {
   // The owned rows are shared with the target, so the Import's "same" part copies onto itself.
+  // With nothing to receive, send or permute on one rank, that copy is all it would do: skipped.
+  if (selfOnly()) return;
   overlap_->doImport(*owned_, *importer(), Tpetra::INSERT);
 }
 
@@ -40,6 +50,7 @@ void Field<Dim>::sumToOwners()
 {
   // Reverse-mode Export with ADD: the owned prefix of the source is the target itself, which
   // Tpetra copies in place (not added), so each owned entry is counted once; remote ghosts add in.
+  if (selfOnly()) return;
   owned_->doExport(*overlap_, *importer(), Tpetra::ADD);
   exchangeHalo();
 }

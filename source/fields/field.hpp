@@ -57,6 +57,8 @@ class Field {
   const Teuchos::RCP<const Map>& ownedMap() const;
   const Teuchos::RCP<const Map>& overlapMap() const;
   const Teuchos::RCP<const typename Layout<Dim>::Import>& importer() const;
+  /// True on one rank when the halo Import only maps the owned rows onto themselves (no ghosts).
+  bool selfOnly() const;
 
   std::shared_ptr<const Layout<Dim>> layout_;
   Location location_;

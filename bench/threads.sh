@@ -6,13 +6,13 @@
 # the parallel efficiency (speed-up / 2). See doc/threads.md.
 #
 # usage: bench/threads.sh <serial build dir> <openmp build dir> [ice args] [mpm args]
-#   ice args default "840 336 20 10" (cells x, cells y, steps, MueLu set-up interval)
+#   ice args default "840 336 20" (cells x, cells y, steps; a 4th argument: the scene's ice section)
 #   mpm args default "1000 10" (cells per side, steps)
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 serial=${1:?usage: bench/threads.sh <serial build dir> <openmp build dir>}
 omp=${2:?usage: bench/threads.sh <serial build dir> <openmp build dir>}
-ice_args=${3:-840 336 20 10}
+ice_args=${3:-840 336 20}
 mpm_args=${4:-1000 10}
 for b in "$serial" "$omp"; do
   for exe in bench/bench_ice bench/bench_mpm; do

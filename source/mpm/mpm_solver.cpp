@@ -427,6 +427,7 @@ void MpmSolver<Dim>::gridToParticlesWith(double dt)
   if (remap) {
     node_velocity_new_->fill(0.0);
     auto momentum = node_velocity_new_->view();
+    auto scatter = Kokkos::Experimental::create_scatter_view(momentum);  // as in particlesToGridWith
     Kokkos::parallel_for(
         "mpm::grid_to_particles_velocity", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count),
         KOKKOS_LAMBDA(const int p) {
@@ -452,11 +453,13 @@ void MpmSolver<Dim>::gridToParticlesWith(double dt)
           }
           for (int d = 0; d < Dim; ++d) vp[d] = v(p, d) = flip * (v(p, d) + dv[d]) + (1.0 - flip) * v_grid[d];
           const double mp = mass(p);
+          auto sums = scatter.access();
           for (int k = 0; k < s.size; ++k) {
             if (lids[k] < 0) continue;
-            for (int d = 0; d < Dim; ++d) Kokkos::atomic_add(&momentum(lids[k], m * Dim + d), s.weight[k] * mp * vp[d]);
+            for (int d = 0; d < Dim; ++d) sums(lids[k], m * Dim + d) += s.weight[k] * mp * vp[d];
           }
         });
+    Kokkos::Experimental::contribute(momentum, scatter);
     node_velocity_new_->sumToOwners();
     const GridConditions<Dim> conditions =
         gridConditions<Dim>(*layout_, materials_, options_, empty_node_mass_, wall_no_slip_);

@@ -322,7 +322,10 @@ void PressureSolver<Dim>::Impl::runCG(const Teuchos::RCP<Operator>& precondition
 {
   auto problem = Teuchos::rcp(new Belos::LinearProblem<Scalar, MultiVector, Operator>(
       matrix, Teuchos::rcpFromRef(x), Teuchos::rcpFromRef(b)));
-  if (!preconditioner.is_null()) problem->setLeftPrec(preconditioner);
+  // Belos's CG applies a left or a right preconditioner the same way (z = M^-1 r), but
+  // LinearProblem::setProblem() also computes the left-preconditioned initial residual, which CG
+  // never reads: as a right preconditioner MueLu runs one V-cycle fewer per solve.
+  if (!preconditioner.is_null()) problem->setRightPrec(preconditioner);
   int verbosity = Belos::Errors + Belos::Warnings;
   if (settings.verbosity >= 2) verbosity += Belos::IterationDetails + Belos::FinalSummary + Belos::StatusTestDetails;
   int iterations = 0;

@@ -30,16 +30,17 @@ namespace cfdmpm {
 
 /// Settings of the ICE step, from the scene's `ice` section (doc/input.md).
 struct IceSettings {
+  // The keys of `cfdmpm.ice`; their defaults and allowed values are in input/valid_parameters.cpp.
   bool enabled = true;                   // false: fluids are an inert background (dry scenes)
   bool isothermal = true;                // true: temperatures keep their values (no energy equation)
   double heat_exchange_coefficient = 0;  // H between every pair of materials (W/(m^3 K))
-  std::string pressure = "implicit";     // "implicit" or "explicit" (for comparison)
-  double exchange_coefficient = 1e15;    // momentum exchange K between every pair (kg/(m^3 s))
-  int max_outer_iterations = 20;
-  double outer_tolerance = 1e-8;         // on max |rhs| / V_cell of the pressure equation
-  double solver_tolerance = 1e-10;       // relative residual of each linear solve (when given)
+  std::string pressure;                  // "implicit" or "explicit" (for comparison)
+  double exchange_coefficient = 0;       // momentum exchange K between every pair (kg/(m^3 s))
+  int max_outer_iterations = 0;
+  double outer_tolerance = 0;            // on max |rhs| / V_cell of the pressure equation (dimensionless)
+  double solver_tolerance = 0;           // relative residual of each linear solve (when given)
   bool solver_tolerance_given = false;   // false: each solve goes as far as the outer test needs
-  double dt_growth = 1.2;                // largest ratio of successive time steps
+  double dt_growth = 0;                  // largest ratio of successive time steps
   Teuchos::ParameterList linear_solver;  // passed to PressureSolver
 
   static IceSettings fromScene(const Scene& scene);
@@ -49,7 +50,7 @@ struct IceSettings {
 struct IceStepReport {
   int outer_iterations = 0;
   int linear_iterations = 0;      // summed over the outer iterations
-  double outer_residual = 0;      // max |rhs| / V at the end (1/s)
+  double outer_residual = 0;      // max |rhs| / V at the end (a fraction of the cell volume)
   bool converged = true;
   int equilibration_failures = 0;
   double max_outflux_fraction = 0;

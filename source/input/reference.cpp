@@ -60,6 +60,7 @@ std::vector<ParameterTable> sceneParameterTables()
   tables.push_back({"Boundary face", "cfdmpm.boundary_conditions.<face>", validBoundaryParameters()});
   tables.push_back({"`cfdmpm.time`", "cfdmpm.time", section("time")});
   tables.push_back({"`cfdmpm.output`", "cfdmpm.output", section("output")});
+  tables.push_back({"`cfdmpm.ice`", "cfdmpm.ice", section("ice")});
   tables.push_back({"`cfdmpm.mpm`", "cfdmpm.mpm", section("mpm")});
   return tables;
 }

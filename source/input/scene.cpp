@@ -707,6 +707,7 @@ Scene readScene(const std::string& path)
     scene.time = readTime(root->sublist("time"));
     scene.output = readOutput(root->sublist("output"));
     scene.mpm = readMpm(root->sublist("mpm"));
+    checkedSection(root->sublist("ice"), "ice");  // read by the ICE solver (IceSettings::fromScene)
   } catch (const InputError& error) {
     throw InputError(path + ": " + error.what());
   }

@@ -102,8 +102,8 @@ struct Scene {
 
 /// The list of valid parameters with defaults and documentation; the single source of truth for
 /// validation and for doc/input.md. Each entry carries a ParameterRule (input/parameter_rule.hpp).
-/// The named-entry sections (materials, regions, boundary_conditions) and the `ice` section are empty
-/// here: their entries follow the templates below, or the ICE solver checks them.
+/// The named-entry sections (materials, regions, boundary_conditions) are empty here: their entries
+/// follow the templates below. `ice.linear_solver` is checked by the pressure solver.
 Teuchos::RCP<const Teuchos::ParameterList> validSceneParameters();
 
 /// Templates for named entries, one per value of their selector key (which each template holds):

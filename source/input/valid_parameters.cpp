@@ -187,6 +187,36 @@ void defineMpm(ParameterList& mpm)
          atLeast(0, "1/s"));
 }
 
+void defineIce(ParameterList& ice)
+{
+  define(ice, "enabled", true,
+         "false: the fluids stay as they are, an inert background, and the solids run alone (a dry scene).",
+         ParameterRule{});
+  define(ice, "isothermal", true,
+         "false: solve the energy equation (pressure work, conduction, heat exchange, advection of T).",
+         ParameterRule{});
+  define(ice, "heat_exchange_coefficient", 0.0, "Heat exchange H between every pair of materials.",
+         atLeast(0, "W/(m^3 K)"));
+  define(ice, "pressure", std::string("implicit"), "Pressure scheme; `explicit` is for comparison only.",
+         oneOf({"implicit", "explicit"}));
+  define(ice, "exchange_coefficient", 1.0e15, "Momentum exchange K between every pair of materials.",
+         atLeast(0, "kg/(m^3 s)"));
+  define(ice, "max_outer_iterations", 20, "Outer iterations of the pressure equation per step at most.", atLeast(1));
+  define(ice, "outer_tolerance", 1.0e-8,
+         "The outer iterations stop once max |rhs| / V of the pressure equation is below this: the volume "
+         "mismatch of a cell in one step, as a fraction of its volume (doc/ice.md).",
+         positive(""));
+  define(ice, "solver_tolerance", 0.0,
+         "Relative residual of each linear pressure solve. 0: each solve stops once its residual's 2-norm is "
+         "below 0.5 `outer_tolerance` V (doc/ice-pressure.md), or at 1e-10 relative if that comes first.",
+         between(0, false, 1e-2, true));
+  define(ice, "dt_growth", 1.2, "Largest ratio of successive time steps.", greaterThan(1));
+  defineSection(ice, "linear_solver",
+                "Settings of the pressure solver (preconditioner, MueLu reuse, ...), checked by it; keys given "
+                "replace cfdmpm's defaults one by one (doc/ice-pressure.md).",
+                false, true);
+}
+
 RCP<ParameterList> buildSceneParameters()
 {
   auto scene = Teuchos::rcp(new ParameterList("cfdmpm"));
@@ -208,7 +238,7 @@ RCP<ParameterList> buildSceneParameters()
                 false, true);
   defineTime(defineSection(*scene, "time", "Time span and time-step control.", true, false));
   defineOutput(defineSection(*scene, "output", "What is written, where and how often.", true, false));
-  defineSection(*scene, "ice", "Settings of the fluid (ICE) solver; checked by that solver.", false, true);
+  defineIce(defineSection(*scene, "ice", "Settings of the fluid (ICE) solver.", false, false));
   defineMpm(defineSection(*scene, "mpm", "Settings of the particle (MPM) solver.", false, false));
   return scene;
 }

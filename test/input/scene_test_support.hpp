@@ -106,7 +106,7 @@ cfdmpm:
     y+: {velocity: free_slip}
   time: {end_time: 0.5, cfl: 0.4, dt_initial: 1.0e-4, dt_min: 1.0e-8, dt_max: 1.0e-3, max_steps: 1000}
   output: {directory: out/test, interval: 0.1, fields: [velocity, pressure, particle_stress], overwrite: true, progress_interval: 5.0}
-  ice: {note: 1}
+  ice: {outer_tolerance: 1.0e-9, solver_tolerance: 1.0e-11, linear_solver: {verbosity: 1}}
   mpm: {}
 )";
 

@@ -54,6 +54,21 @@ TEST_F(SceneTest, MpmSettingsAreChecked)
                  {"cfdmpm.mpm.friction", "wall_friction"});
 }
 
+TEST_F(SceneTest, IceSettingsAreChecked)
+{
+  const std::string ice = "  ice: {outer_tolerance: 1.0e-9, solver_tolerance: 1.0e-11, linear_solver: {verbosity: 1}}\n";
+  expectMentions(errorOf(replaced(kFullScene, ice, "  ice: {pressure: semi}\n")),
+                 {"cfdmpm.ice.pressure", "semi", "implicit", "explicit"});
+  expectMentions(errorOf(replaced(kFullScene, ice, "  ice: {solver_tolerance: 0.5}\n")),
+                 {"cfdmpm.ice.solver_tolerance", "0.5", "[0, 0.01)"});
+  expectMentions(errorOf(replaced(kFullScene, ice, "  ice: {dt_growth: 1}\n")),
+                 {"cfdmpm.ice.dt_growth", "1", "> 1"});
+  expectMentions(errorOf(replaced(kFullScene, ice, "  ice: {isothermal: yes please}\n")),
+                 {"cfdmpm.ice.isothermal", "yes please", "true or false"});
+  expectMentions(errorOf(replaced(kFullScene, ice, "  ice: {outer_tolerence: 1.0e-9}\n")),
+                 {"cfdmpm.ice.outer_tolerence", "unknown key", "outer_tolerance"});
+}
+
 TEST_F(SceneTest, SecondTopLevelKeyIsRefusedWithItsLine)
 {
   // Teuchos would drop this section without a word.

@@ -101,9 +101,14 @@ TEST_F(SceneTest, FullSceneFillsEveryField)
   EXPECT_TRUE(scene.output.overwrite);
   EXPECT_EQ(scene.output.progress_interval, 5.0);
 
-  // The solver sections are passed on untouched.
+  // The ICE section is checked here and read by the ICE solver from the list; its linear_solver
+  // sublist is passed on untouched to the pressure solver.
   ASSERT_FALSE(scene.parameters.is_null());
-  EXPECT_EQ(scene.parameters->sublist("ice").get<int>("note"), 1);
+  const auto& ice = scene.parameters->sublist("ice");
+  EXPECT_EQ(ice.get<double>("outer_tolerance"), 1e-9);
+  EXPECT_EQ(ice.get<double>("solver_tolerance"), 1e-11);
+  EXPECT_EQ(ice.get<double>("dt_growth"), 1.2);
+  EXPECT_EQ(ice.sublist("linear_solver").get<int>("verbosity"), 1);
   EXPECT_TRUE(scene.parameters->isSublist("mpm"));
   EXPECT_EQ(scene.path, directory_.string() + "/scene.yaml");
 }
@@ -145,6 +150,8 @@ TEST_F(SceneTest, MissingKeysTakeTheirDefaults)
   EXPECT_DOUBLE_EQ(air.get<double>("specific_heat"), 287.0 / 0.4);  // c_v = R / (gamma - 1)
   EXPECT_EQ(air.get<double>("thermal_conductivity"), 0.0);
   EXPECT_TRUE(scene.parameters->isSublist("ice"));
+  EXPECT_EQ(scene.parameters->sublist("ice").get<double>("solver_tolerance"), 0.0);  // from outer_tolerance
+  EXPECT_EQ(scene.parameters->sublist("ice").get<std::string>("pressure"), "implicit");
   EXPECT_TRUE(scene.parameters->isSublist("mpm"));
   EXPECT_EQ(scene.parameters->sublist("domain").get<int>("ghost_width"), 2);
   EXPECT_EQ(scene.mpm.shape_function, "gimp");

@@ -1,15 +1,17 @@
-// Advection kernels. One step, per material (doc/ice-advection.md):
-//   1. the outflow check: Σ_faces V_out <= V_cell everywhere, or the step is refused;
-//   2. the mass slabs: each cell's limited linear mass profile gives the mass leaving through each
-//      face (owned cells and the first ghost layer, so that every owned face has its donor);
-//   3. the slab values of every mass-specific column of every field, in one pass (the slab
-//      geometry and the remaining mass are computed once per cell and material);
-//   4. one pass over the owned cells writes the new mass and the new q of every column in place
+// Advection kernels. One step, per material (doc/ice-advection.md), three passes over the cells:
+//   1. the outflow check: Σ_faces V_out <= V_cell everywhere, or the step is refused (one
+//      reduction, which also finds the cell of the maximum);
+//   2. the slabs, owned cells and the first ghost layer (so that every owned face has its donor):
+//      each cell's limited linear mass profile gives the mass leaving through each face, then the
+//      slab values of every mass-specific column of every field (the slab geometry and the
+//      remaining mass are computed once per cell and material);
+//   3. one pass over the owned cells writes the new mass and the new q of every column in place
 //      (it reads other cells only through the slab arrays); ghosts of the outputs refreshed.
 #include "ice/advection.hpp"
 
 #include <Teuchos_CommHelpers.hpp>
 
+#include <cfloat>
 #include <climits>
 #include <sstream>
 #include <stdexcept>
@@ -42,14 +44,31 @@ struct CellStencil {
     return ijk(c, 0) + cells[0] * (ijk(c, 1) + cells[1] * k);
   }
 
+  static constexpr int kBlock = Dim == 2 ? 9 : 27;
+
+  /// The ids of cell c's neighbours (face f) and of its 3^Dim block, read once per cell by the
+  /// kernels and passed to the functions below.
+  struct Local {
+    LocalOrdinal neighbour[2 * Dim];
+    LocalOrdinal block[kBlock];
+  };
+  KOKKOS_INLINE_FUNCTION Local local(int c) const
+  {
+    Local l;
+    for (int f = 0; f < 2 * Dim; ++f) l.neighbour[f] = neighbours(c, f);
+    for (int k = 0; k < kBlock; ++k) l.block[k] = block(c, k);
+    return l;
+  }
+
   /// Minimum and maximum of column `col` over the cell and its 3^Dim - 1 neighbours (diagonals
   /// included) that are inside the domain and held by this rank.
   template <class View>
-  KOKKOS_INLINE_FUNCTION void blockBounds(const View& v, int c, int col, double& lo, double& hi) const
+  KOKKOS_INLINE_FUNCTION void blockBounds(const View& v, int c, const Local& l, int col, double& lo,
+                                          double& hi) const
   {
     lo = hi = v(c, col);
-    for (int k = 0; k < int(block.extent(1)); ++k) {
-      const LocalOrdinal n = block(c, k);
+    for (int k = 0; k < kBlock; ++k) {
+      const LocalOrdinal n = l.block[k];
       if (n < 0) continue;
       const double value = v(n, col);
       lo = value < lo ? value : lo;
@@ -60,9 +79,9 @@ struct CellStencil {
   /// Unlimited gradient of column `col` in direction d: central difference, one-sided next to a
   /// wall (or the edge of the ghost layers), zero with no neighbour in d.
   template <class View>
-  KOKKOS_INLINE_FUNCTION double gradient(const View& v, int c, int col, int d) const
+  KOKKOS_INLINE_FUNCTION double gradient(const View& v, int c, const Local& l, int col, int d) const
   {
-    const LocalOrdinal lower = neighbours(c, 2 * d), upper = neighbours(c, 2 * d + 1);
+    const LocalOrdinal lower = l.neighbour[2 * d], upper = l.neighbour[2 * d + 1];
     if (lower >= 0 && upper >= 0) return (v(upper, col) - v(lower, col)) / (2 * spacing[d]);
     if (upper >= 0) return (v(upper, col) - v(c, col)) / spacing[d];
     if (lower >= 0) return (v(c, col) - v(lower, col)) / spacing[d];
@@ -91,36 +110,39 @@ struct Slabs {
   /// for an owned cell's faces).
   KOKKOS_INLINE_FUNCTION double normalVelocity(int c, int f, int m) const
   {
+    return normalVelocity(c, f, m, neighbours(c, f));
+  }
+  /// The same with the neighbour across f already read.
+  KOKKOS_INLINE_FUNCTION double normalVelocity(int c, int f, int m, LocalOrdinal n) const
+  {
     const int d = f / 2;
-    const LocalOrdinal n = neighbours(c, f);
     if (f % 2 == 0) return n == Layout<Dim>::kOutsideDomain ? 0.0 : velocity[d](c, m);
     return n >= 0 ? velocity[d](n, m) : 0.0;
   }
 
-  /// V_out / V_cell through face f: |u| Δt / Δx when the flow leaves the cell, else 0.
-  KOKKOS_INLINE_FUNCTION double outflowFraction(int c, int f, int m) const
-  {
-    const double u = normalVelocity(c, f, m);
-    const double outward = f % 2 == 0 ? -u : u;
-    return outward > 0 ? outward * dt / spacing[f / 2] : 0.0;
-  }
-
-  /// Σ_faces V_out / V_cell: more than 1 empties the cell in one step.
-  KOKKOS_INLINE_FUNCTION double totalOutflowFraction(int c, int m) const
+  /// Σ_faces V_out / V_cell: more than 1 empties the cell in one step. neighbour[f]: the cell's
+  /// neighbour across face f.
+  KOKKOS_INLINE_FUNCTION double totalOutflowFraction(int c, int m, const LocalOrdinal neighbour[2 * Dim]) const
   {
     double total = 0;
-    for (int f = 0; f < 2 * Dim; ++f) total += outflowFraction(c, f, m);
+    for (int f = 0; f < 2 * Dim; ++f) {
+      const double u = normalVelocity(c, f, m, neighbour[f]);
+      const double outward = f % 2 == 0 ? -u : u;
+      total += outward > 0 ? outward * dt / spacing[f / 2] : 0.0;
+    }
     return total;
   }
 
-  /// For every face f of cell c and material m: the outflow fraction (as outflowFraction) and the
+  /// For every face f of cell c and material m: the outflow fraction V_out / V_cell and the
   /// offset r[f] from the cell centre to the centroid of the outflow slab. Normal to the face: the
   /// slab of thickness |u|Δt against the face. Along the face: the donor's mean transverse velocity
   /// times -Δt/2 (the swept region's centroid). The cell's 2 Dim face velocities are read once.
-  KOKKOS_INLINE_FUNCTION void cellSlabs(int c, int m, double fraction[2 * Dim], double r[2 * Dim][Dim]) const
+  /// neighbour[f]: the cell's neighbour across face f.
+  KOKKOS_INLINE_FUNCTION void cellSlabs(int c, int m, const LocalOrdinal neighbour[2 * Dim], double fraction[2 * Dim],
+                                        double r[2 * Dim][Dim]) const
   {
     double u[2 * Dim];
-    for (int f = 0; f < 2 * Dim; ++f) u[f] = normalVelocity(c, f, m);
+    for (int f = 0; f < 2 * Dim; ++f) u[f] = normalVelocity(c, f, m, neighbour[f]);
     for (int f = 0; f < 2 * Dim; ++f) {
       const int d = f / 2;
       const double outward = f % 2 == 0 ? -u[f] : u[f];
@@ -140,6 +162,44 @@ struct Slabs {
 /// 2. Remainder bound: what stays in the cell after the outflow slabs leave has the mean
 ///    value - φ·S / remaining, which must also lie within [lo, hi]; S = Σ_out w_f g·r_f with the
 ///    slabs' weights w_f, and `remaining` = weight left in the cell (>= 0).
+/// The largest outflow fraction Σ_faces V_out / V_cell over cells and materials, and among the
+/// entries that attain it the lowest key = global cell id · materials + material (so that every
+/// decomposition names the same cell): one reduction over the cells.
+struct LargestOutflow {
+  double value;
+  long long key;
+};
+
+template <int Dim>
+struct LargestOutflowReduction {
+  using value_type = LargestOutflow;
+  Slabs<Dim> slabs;
+  CellStencil<Dim> stencil;
+  int materials;
+
+  KOKKOS_INLINE_FUNCTION void operator()(const int c, value_type& best) const
+  {
+    LocalOrdinal neighbour[2 * Dim];
+    for (int f = 0; f < 2 * Dim; ++f) neighbour[f] = stencil.neighbours(c, f);
+    for (int m = 0; m < materials; ++m) {
+      const double value = slabs.totalOutflowFraction(c, m, neighbour);
+      if (!(value >= best.value)) continue;  // also skips a NaN
+      const long long key = stencil.globalId(c) * materials + m;
+      if (value > best.value || key < best.key) best.value = value, best.key = key;
+    }
+  }
+  KOKKOS_INLINE_FUNCTION void join(volatile value_type& best, const volatile value_type& other) const
+  {
+    if (other.value > best.value || (other.value == best.value && other.key < best.key))
+      best.value = other.value, best.key = other.key;
+  }
+  KOKKOS_INLINE_FUNCTION void init(value_type& best) const
+  {
+    best.value = -DBL_MAX;
+    best.key = LLONG_MAX;
+  }
+};
+
 KOKKOS_INLINE_FUNCTION double limiter(double value, double lo, double hi, double spread, double remaining,
                                       double S)
 {
@@ -199,41 +259,22 @@ Advector<Dim>::Advector(std::shared_ptr<const Layout<Dim>> layout, int materials
 template <int Dim>
 AdvectionStatus Advector<Dim>::checkOutflux(const FaceField<Dim>& face_velocity, double dt) const
 {
-  const Slabs<Dim> slabs(face_velocity, *layout_, dt, options_.transverse_correction);
-  const CellStencil<Dim> stencil(*layout_, block_);
-  const int materials = materials_;
-  const int entries = layout_->ownedCells() * materials;
-
-  double local_max = 0;
-  Kokkos::parallel_reduce(
-      "advection outflux max", Kokkos::RangePolicy<ExecutionSpace>(0, entries),
-      KOKKOS_LAMBDA(int i, double& max) {
-        const double value = slabs.totalOutflowFraction(i / materials, i % materials);
-        if (value > max) max = value;
-      },
-      Kokkos::Max<double>(local_max));
+  const LargestOutflowReduction<Dim> reduction{Slabs<Dim>(face_velocity, *layout_, dt, options_.transverse_correction),
+                                               CellStencil<Dim>(*layout_, block_), materials_};
+  LargestOutflow local;
+  Kokkos::parallel_reduce("advection outflux max", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+                          reduction, local);
   AdvectionStatus status;
   const auto& comm = *layout_->comm();
-  Teuchos::reduceAll(comm, Teuchos::REDUCE_MAX, local_max, Teuchos::outArg(status.max_outflux_fraction));
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_MAX, local.value, Teuchos::outArg(status.max_outflux_fraction));
 
   // The cell that attains the maximum, lowest global id first, so every rank count reports the same.
-  // Only ranks that hold the maximum need to look for it.
-  const double global_max = status.max_outflux_fraction;
-  long long local_first = LLONG_MAX;
-  if (local_max == global_max)
-    Kokkos::parallel_reduce(
-        "advection outflux cell", Kokkos::RangePolicy<ExecutionSpace>(0, entries),
-        KOKKOS_LAMBDA(int i, long long& first) {
-          if (slabs.totalOutflowFraction(i / materials, i % materials) != global_max) return;
-          const long long key = stencil.globalId(i / materials) * materials + i % materials;
-          if (key < first) first = key;
-        },
-        Kokkos::Min<long long>(local_first));
+  const long long local_first = local.value == status.max_outflux_fraction ? local.key : LLONG_MAX;
   long long first = LLONG_MAX;
   Teuchos::reduceAll(comm, Teuchos::REDUCE_MIN, local_first, Teuchos::outArg(first));
   if (first != LLONG_MAX) {
-    status.cell = first / materials;
-    status.material = int(first % materials);
+    status.cell = first / materials_;
+    status.material = int(first % materials_);
   }
   status.ok = status.max_outflux_fraction <= 1.0;
   return status;
@@ -262,57 +303,15 @@ AdvectionStatus Advector<Dim>::advect(FaceField<Dim>& face_velocity, double dt, 
   mass.exchangeHalo();
   for (Field<Dim>* q : mass_specific) q->exchangeHalo();
 
-  // 2. Mass leaving each cell through each face, from the limited density profile of the donor.
-  reconstructMass(face_velocity, dt, mass);
-
-  // 3. The slab values of every mass-specific column (the mass is still the old one).
-  if (!mass_specific.empty()) reconstructQuantities(face_velocity, dt, mass, mass_specific);
+  // 2. + 3. Mass leaving each cell through each face, from the limited density profile of the
+  //    donor, and the slab values of every mass-specific column, in one pass.
+  reconstruct(face_velocity, dt, mass, mass_specific);
 
   // 4. New mass and compatible update of every column, then the outputs' ghosts.
   update(mass, mass_specific);
   mass.exchangeHalo();
   for (Field<Dim>* q : mass_specific) q->exchangeHalo();
   return status;
-}
-
-template <int Dim>
-void Advector<Dim>::reconstructMass(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass)
-{
-  const Slabs<Dim> slabs(face_velocity, *layout_, dt, options_.transverse_correction);
-  const CellStencil<Dim> stencil(*layout_, block_);
-  const auto M = mass.view();
-  const auto outflow_mass = outflow_mass_;
-  const int materials = materials_;
-
-  // The linear profile M + φ g·r of the cell's mass (the density times V_cell); a slab of fraction
-  // w = V_out / V_cell carries w·(M + φ g·r_f) (Uintah's SecondOrderAdvector with compatible
-  // fluxes; the remainder bound keeps the mass left behind >= 0 at any outflow Courant number <= 1).
-  Kokkos::parallel_for(
-      "advection mass slabs", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->overlapCells()),
-      KOKKOS_LAMBDA(int c) {
-        for (int m = 0; m < materials; ++m) {
-          double fraction[2 * Dim], r[2 * Dim][Dim];
-          slabs.cellSlabs(c, m, fraction, r);
-          double g[Dim], spread = 0;
-          for (int d = 0; d < Dim; ++d) {
-            g[d] = stencil.gradient(M, c, m, d);
-            spread += 0.5 * (g[d] < 0 ? -g[d] : g[d]) * stencil.spacing[d];
-          }
-          double slope[2 * Dim];  // g·r_f
-          double remaining = 1.0, S = 0.0;
-          for (int f = 0; f < 2 * Dim; ++f) {
-            slope[f] = 0;
-            for (int d = 0; d < Dim; ++d) slope[f] += g[d] * r[f][d];
-            remaining -= fraction[f];
-            S += fraction[f] * slope[f];
-          }
-          double lo, hi;
-          stencil.blockBounds(M, c, m, lo, hi);
-          const double value = M(c, m);
-          const double phi = limiter(value, lo, hi, spread, remaining > 0 ? remaining : 0.0, S);
-          for (int f = 0; f < 2 * Dim; ++f) outflow_mass(c, f, m) = fraction[f] * (value + phi * slope[f]);
-        }
-      });
 }
 
 namespace {
@@ -346,8 +345,8 @@ QuantityColumns<Dim, View, kMaxFields> quantityColumns(const std::vector<FieldPo
 }  // namespace
 
 template <int Dim>
-void Advector<Dim>::reconstructQuantities(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass,
-                                          const std::vector<Field<Dim>*>& mass_specific)
+void Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass,
+                                const std::vector<Field<Dim>*>& mass_specific)
 {
   const Slabs<Dim> slabs(face_velocity, *layout_, dt, options_.transverse_correction);
   const CellStencil<Dim> stencil(*layout_, block_);
@@ -355,7 +354,8 @@ void Advector<Dim>::reconstructQuantities(const FaceField<Dim>& face_velocity, d
   const auto q = quantityColumns<Dim, kMaxFields, typename Field<Dim>::ConstView>(
       std::vector<const Field<Dim>*>(mass_specific.begin(), mass_specific.end()), materials_);
   const LocalOrdinal cells = layout_->overlapCells();
-  if (outflow_value_.extent(0) != std::size_t(cells) || outflow_value_.extent(2) < std::size_t(q.total)) {
+  if (q.total > 0 &&
+      (outflow_value_.extent(0) != std::size_t(cells) || outflow_value_.extent(2) < std::size_t(q.total))) {
     outflow_value_ = WorkView("advection outflow value", cells, 2 * Dim, q.total);
     bounds_ = WorkView("advection bounds", cells, q.total, 2);
   }
@@ -364,41 +364,71 @@ void Advector<Dim>::reconstructQuantities(const FaceField<Dim>& face_velocity, d
   const auto bounds = bounds_;
   const int materials = materials_;
 
-  // The same for q, whose slabs weigh their mass F_f: the limited profile keeps q within its block
-  // bounds in the slabs and in the mass left behind, so the new q is a mass-weighted mean of values
-  // within bounds (compatible fluxes). The slab geometry and the mass left behind depend on the
-  // cell and material only: computed once for all columns.
+  // Per cell (owned and ghost, so that every owned face has its donor) and material, the slab
+  // geometry from the cell's 2 Dim face velocities, then:
+  // - the mass slabs: the linear profile M + φ g·r of the cell's mass (the density times V_cell);
+  //   a slab of fraction w = V_out / V_cell carries F = w·(M + φ g·r_f) (Uintah's
+  //   SecondOrderAdvector with compatible fluxes; the remainder bound keeps the mass left behind
+  //   >= 0 at any outflow Courant number <= 1);
+  // - the same for every column q, whose slabs weigh their mass F_f: the limited profile keeps q
+  //   within its block bounds in the slabs and in the mass left behind, so the new q is a
+  //   mass-weighted mean of values within bounds (compatible fluxes).
+  // Both read the old mass and the cell's own slabs only.
   Kokkos::parallel_for(
-      "advection quantity slabs", Kokkos::RangePolicy<ExecutionSpace>(0, cells), KOKKOS_LAMBDA(int c) {
+      "advection slabs", Kokkos::RangePolicy<ExecutionSpace>(0, cells), KOKKOS_LAMBDA(int c) {
+        const auto local = stencil.local(c);
         for (int m = 0; m < materials; ++m) {
           double fraction[2 * Dim], r[2 * Dim][Dim];
-          slabs.cellSlabs(c, m, fraction, r);
-          double remaining = M(c, m);
-          for (int f = 0; f < 2 * Dim; ++f) remaining -= outflow_mass(c, f, m);
-          if (!(remaining > 0)) remaining = 0.0;
+          slabs.cellSlabs(c, m, local.neighbour, fraction, r);
+          double g[Dim], spread = 0;
+          for (int d = 0; d < Dim; ++d) {
+            g[d] = stencil.gradient(M, c, local, m, d);
+            spread += 0.5 * (g[d] < 0 ? -g[d] : g[d]) * stencil.spacing[d];
+          }
+          double slope[2 * Dim];  // g·r_f
+          double remaining = 1.0, S = 0.0;
+          for (int f = 0; f < 2 * Dim; ++f) {
+            slope[f] = 0;
+            for (int d = 0; d < Dim; ++d) slope[f] += g[d] * r[f][d];
+            remaining -= fraction[f];
+            S += fraction[f] * slope[f];
+          }
+          double lo, hi;
+          stencil.blockBounds(M, c, local, m, lo, hi);
+          const double value = M(c, m);
+          const double phi = limiter(value, lo, hi, spread, remaining > 0 ? remaining : 0.0, S);
+          double slab_mass[2 * Dim];
+          double left = value;  // the mass that stays in the cell
+          for (int f = 0; f < 2 * Dim; ++f) {
+            slab_mass[f] = fraction[f] * (value + phi * slope[f]);
+            outflow_mass(c, f, m) = slab_mass[f];
+            left -= slab_mass[f];
+          }
+          if (!(left > 0)) left = 0.0;
+
           for (int field = 0; field < q.fields; ++field) {
             const auto& Q = q.field[field];
             for (int j = 0; j < q.width[field]; ++j) {
               const int col = m * q.width[field] + j, slot = q.first[field] + col;
-              double g[Dim], spread = 0;
+              double gq[Dim], spread_q = 0;
               for (int d = 0; d < Dim; ++d) {
-                g[d] = stencil.gradient(Q, c, col, d);
-                spread += 0.5 * (g[d] < 0 ? -g[d] : g[d]) * stencil.spacing[d];
+                gq[d] = stencil.gradient(Q, c, local, col, d);
+                spread_q += 0.5 * (gq[d] < 0 ? -gq[d] : gq[d]) * stencil.spacing[d];
               }
-              double slope[2 * Dim];
-              double S = 0.0;
+              double slope_q[2 * Dim];
+              double S_q = 0.0;
               for (int f = 0; f < 2 * Dim; ++f) {
-                slope[f] = 0;
-                for (int d = 0; d < Dim; ++d) slope[f] += g[d] * r[f][d];
-                S += outflow_mass(c, f, m) * slope[f];
+                slope_q[f] = 0;
+                for (int d = 0; d < Dim; ++d) slope_q[f] += gq[d] * r[f][d];
+                S_q += slab_mass[f] * slope_q[f];
               }
-              double lo, hi;
-              stencil.blockBounds(Q, c, col, lo, hi);
-              const double value = Q(c, col);
-              const double phi = limiter(value, lo, hi, spread, remaining, S);
-              for (int f = 0; f < 2 * Dim; ++f) outflow_value(c, f, slot) = value + phi * slope[f];
-              bounds(c, slot, 0) = lo;
-              bounds(c, slot, 1) = hi;
+              double lo_q, hi_q;
+              stencil.blockBounds(Q, c, local, col, lo_q, hi_q);
+              const double value_q = Q(c, col);
+              const double phi_q = limiter(value_q, lo_q, hi_q, spread_q, left, S_q);
+              for (int f = 0; f < 2 * Dim; ++f) outflow_value(c, f, slot) = value_q + phi_q * slope_q[f];
+              bounds(c, slot, 0) = lo_q;
+              bounds(c, slot, 1) = hi_q;
             }
           }
         }
@@ -422,12 +452,16 @@ void Advector<Dim>::update(Field<Dim>& mass, const std::vector<Field<Dim>*>& mas
   // Cell c's entries are read and written by its own iteration only, so the update is in place.
   Kokkos::parallel_for(
       "advection update", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()), KOKKOS_LAMBDA(int c) {
+        LocalOrdinal neighbour[2 * Dim];
+        for (int f = 0; f < 2 * Dim; ++f) neighbour[f] = neighbours(c, f);
         for (int m = 0; m < materials; ++m) {
           double mass_new = M(c, m);
+          double out[2 * Dim], in[2 * Dim];  // the slab masses leaving and entering through each face
           for (int f = 0; f < 2 * Dim; ++f) {
-            const LocalOrdinal n = neighbours(c, f);
-            const double in = n >= 0 ? outflow_mass(n, f ^ 1, m) : 0.0;
-            mass_new += in - outflow_mass(c, f, m);
+            const LocalOrdinal n = neighbour[f];
+            in[f] = n >= 0 ? outflow_mass(n, f ^ 1, m) : 0.0;
+            out[f] = outflow_mass(c, f, m);
+            mass_new += in[f] - out[f];
           }
           for (int field = 0; field < q.fields; ++field) {
             const auto& Q = q.field[field];
@@ -437,13 +471,11 @@ void Advector<Dim>::update(Field<Dim>& mass, const std::vector<Field<Dim>*>& mas
               double lo = bounds(c, slot, 0), hi = bounds(c, slot, 1);
               double change = 0;
               for (int f = 0; f < 2 * Dim; ++f) {
-                change -= outflow_mass(c, f, m) * (outflow_value(c, f, slot) - value_old);
-                const LocalOrdinal n = neighbours(c, f);
-                if (n < 0) continue;
-                const double in = outflow_mass(n, f ^ 1, m);
-                if (in == 0) continue;
+                change -= out[f] * (outflow_value(c, f, slot) - value_old);
+                const LocalOrdinal n = neighbour[f];
+                if (n < 0 || in[f] == 0) continue;
                 const double q_in = outflow_value(n, f ^ 1, slot);
-                change += in * (q_in - value_old);
+                change += in[f] * (q_in - value_old);
                 lo = q_in < lo ? q_in : lo;
                 hi = q_in > hi ? q_in : hi;
               }

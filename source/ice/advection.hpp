@@ -74,9 +74,8 @@ class Advector {
   static constexpr int kMaxFields = 8;
 
  private:
-  void reconstructMass(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass);
-  void reconstructQuantities(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass,
-                             const std::vector<Field<Dim>*>& mass_specific);
+  void reconstruct(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass,
+                   const std::vector<Field<Dim>*>& mass_specific);
   void update(Field<Dim>& mass, const std::vector<Field<Dim>*>& mass_specific);
 
   std::shared_ptr<const Layout<Dim>> layout_;

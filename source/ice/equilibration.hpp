@@ -90,6 +90,9 @@ KOKKOS_INLINE_FUNCTION double insideBracket(double lo, double hi)
 ///   the EOS ranges is replaced by a point inside).
 /// Materials with zero mass density take no part in the root; their density, sound speed and
 /// compressibility are still evaluated at the result pressure.
+/// Count > 0 fixes the number of materials at compile time (loops with constant bounds; `count` must
+/// equal it, else InvalidInput); 0 reads it from `count`.
+template <int Count = 0>
 KOKKOS_INLINE_FUNCTION
 EquilibrationResult equilibrationPressure(int count, const MaterialArray<Eos>& eos,
                                           const MaterialArray<double>& mass_density,
@@ -98,20 +101,22 @@ EquilibrationResult equilibrationPressure(int count, const MaterialArray<Eos>& e
 {
   EquilibrationResult result;
   if (count < 1 || count > kMaxMaterials) return result;
+  if (Count > 0 && count != Count) return result;
+  const int n = Count > 0 ? Count : count;
 
   // The bracket [lo, hi]. First, bounds on the root: alone in the cell, material m would sit at
   // p_m(rho_CC,m); the others only squeeze it, so p >= max_m p_m(rho_CC,m). And at the root some
   // material fills at least 1/n of the cell (n materials with mass), so p <= max_m p_m(n rho_CC,m).
   // Then the pressures every present material can represent (open bounds).
   int present = 0;
-  for (int m = 0; m < count; ++m) {
+  for (int m = 0; m < n; ++m) {
     if (!(mass_density[m] >= 0.0)) return result;
     if (mass_density[m] > 0.0) ++present;
   }
   if (present == 0) return result;
   double lower_root = -DBL_MAX, upper_root = -DBL_MAX;
   double lo = -DBL_MAX, hi = DBL_MAX;
-  for (int m = 0; m < count; ++m) {
+  for (int m = 0; m < n; ++m) {
     if (mass_density[m] == 0.0) continue;
     const double T = temperature[m];
     // Each bound is widened by its round-off, 16 eps (|p| + rho dp/drho), so that it is a bound of
@@ -158,7 +163,7 @@ EquilibrationResult equilibrationPressure(int count, const MaterialArray<Eos>& e
     double sum = 0.0;        // S = sum theta
     double slope = 0.0;      // S' = d(sum theta)/dp < 0
     double gas_slope = 0.0;  // the part of S' from gas-like materials (theta ~ 1/p)
-    for (int m = 0; m < count; ++m) {
+    for (int m = 0; m < n; ++m) {
       if (mass_density[m] == 0.0) continue;
       const double rho = eos[m].density(p, temperature[m]);
       const double theta = mass_density[m] / rho;
@@ -217,7 +222,7 @@ EquilibrationResult equilibrationPressure(int count, const MaterialArray<Eos>& e
 
   // Values of every material (including those without mass) at the final pressure.
   result.pressure = p;
-  for (int m = 0; m < count; ++m) {
+  for (int m = 0; m < n; ++m) {
     const double T = temperature[m];
     if (mass_density[m] == 0.0 || !evaluated || evaluated_at != p) {
       result.density[m] = eos[m].density(p, T);

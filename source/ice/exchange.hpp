@@ -98,15 +98,89 @@ struct ExchangeSystem {
 
 KOKKOS_INLINE_FUNCTION bool isFinite(double x) { return x - x == 0.0; }
 
-/// Applies the implicit exchange in place to `components` quantities q[m][c] (velocity components,
-/// a temperature, a specific volume). Returns Ok unless something is not finite.
+/// The elimination below written out for exactly two materials: the same operations in the same
+/// order, so the results are identical to the bit, without the index lists and loops over runtime
+/// counts. With both present, S = [[w0 + g01, -g01], [-g10, w1 + g10]] and GTH gives the pivots
+/// w0 + g01 and w1 + l w0 (l = g10/(w0 + g01)): sums of non-negative terms, as in the general case.
 template <int MaxComponents>
-KOKKOS_INLINE_FUNCTION ExchangeStatus implicitExchange(const ExchangeSystem& system,
-                                                       const ExchangeCoefficients& K,
-                                                       double (&q)[kMaxMaterials][MaxComponents],
-                                                       int components)
+KOKKOS_INLINE_FUNCTION ExchangeStatus implicitExchangeTwo(const ExchangeSystem& system,
+                                                          const ExchangeCoefficients& K,
+                                                          double (&q)[kMaxMaterials][MaxComponents],
+                                                          int components)
 {
-  const int count = system.count;  // 0 ... kMaxMaterials, checked by the callers
+  const double w0 = system.weight[0], w1 = system.weight[1];
+  const double t0 = system.volume_fraction[0], t1 = system.volume_fraction[1];
+  bool finite = isFinite(w0) && isFinite(w1) && isFinite(t0) && isFinite(t1) &&
+                isFinite(system.rate_scale[0]) && isFinite(system.rate_scale[1]);
+  for (int c = 0; c < components; ++c) finite = finite && isFinite(q[0][c]) && isFinite(q[1][c]);
+  if (!finite) return ExchangeStatus::NonFinite;
+  if (K(0, 1) == 0.0 && K(1, 0) == 0.0) return ExchangeStatus::Ok;  // no exchange: values unchanged
+
+  const double dt = system.dt;
+  if (w0 > 0.0 && w1 > 0.0) {
+    const double total_weight = w0 + w1;
+    const double g01 = dt * t0 * t1 * K(0, 1);
+    const double g10 = dt * t1 * t0 * K(1, 0);
+    const double pivot0 = w0 + g01;
+    const bool eliminate = g10 != 0.0;
+    const double l = eliminate ? g10 / pivot0 : 0.0;
+    const double pivot1 = eliminate ? w1 + l * w0 : w1;
+    for (int c = 0; c < components; ++c) {
+      double sum = 0.0;  // 0.0 + ... as in the general case (the sign of a zero sum)
+      sum += w0 * q[0][c];
+      sum += w1 * q[1][c];
+      const double mean = sum / total_weight;
+      double r0 = w0 * (q[0][c] - mean);
+      double r1 = w1 * (q[1][c] - mean);
+      if (eliminate) r1 += l * r0;
+      r1 = r1 / pivot1;
+      r0 = (r0 + g01 * r1) / pivot0;
+      double drift = 0.0;
+      drift += w0 * r0;
+      drift += w1 * r1;
+      drift /= total_weight;
+      q[0][c] = mean + (r0 - drift);
+      q[1][c] = mean + (r1 - drift);
+    }
+  } else if (w0 > 0.0 || w1 > 0.0) {
+    // One material with mass (a) keeps its value up to round-off; the massless one (b) follows its
+    // row of A.
+    const int a = w0 > 0.0 ? 0 : 1, b = 1 - a;
+    const double w = a == 0 ? w0 : w1;
+    const double beta = dt * system.rate_scale[b] * system.volume_fraction[a] * K(b, a);
+    const double beta_sum = 0.0 + beta;
+    for (int c = 0; c < components; ++c) {
+      double sum = 0.0;
+      sum += w * q[a][c];
+      const double mean = sum / w;
+      const double r = (w * (q[a][c] - mean)) / w;
+      double drift = 0.0;
+      drift += w * r;
+      drift /= w;
+      q[a][c] = mean + (r - drift);
+      double pull = 0.0;
+      pull += beta * q[a][c];
+      q[b][c] = (q[b][c] + pull) / (1.0 + beta_sum);
+    }
+  } else {
+    for (int c = 0; c < components; ++c) {
+      q[0][c] = (q[0][c] + 0.0) / (1.0 + 0.0);
+      q[1][c] = (q[1][c] + 0.0) / (1.0 + 0.0);
+    }
+  }
+  for (int c = 0; c < components; ++c)
+    if (!isFinite(q[0][c]) || !isFinite(q[1][c])) return ExchangeStatus::NonFinite;
+  return ExchangeStatus::Ok;
+}
+
+/// The general elimination for any number of materials (Count > 0: fixed at compile time).
+template <int MaxComponents, int Count>
+KOKKOS_INLINE_FUNCTION ExchangeStatus implicitExchangeGeneral(const ExchangeSystem& system,
+                                                              const ExchangeCoefficients& K,
+                                                              double (&q)[kMaxMaterials][MaxComponents],
+                                                              int components)
+{
+  const int count = Count > 0 ? Count : system.count;  // 0 ... kMaxMaterials, checked by the callers
 
   // Materials with mass take part in the solve; list them and their couplings G = dt theta theta K.
   int present[kMaxMaterials];
@@ -199,6 +273,22 @@ KOKKOS_INLINE_FUNCTION ExchangeStatus implicitExchange(const ExchangeSystem& sys
   return ExchangeStatus::Ok;
 }
 
+/// Applies the implicit exchange in place to `components` quantities q[m][c] (velocity components,
+/// a temperature, a specific volume). Returns Ok unless something is not finite.
+/// Count > 0 fixes the number of materials at compile time (it must equal system.count): Count = 2
+/// takes the written-out elimination (implicitExchangeTwo), other counts the general one.
+template <int MaxComponents, int Count = 0>
+KOKKOS_INLINE_FUNCTION ExchangeStatus implicitExchange(const ExchangeSystem& system,
+                                                       const ExchangeCoefficients& K,
+                                                       double (&q)[kMaxMaterials][MaxComponents],
+                                                       int components)
+{
+  if constexpr (Count == 2)
+    return implicitExchangeTwo<MaxComponents>(system, K, q, components);
+  else
+    return implicitExchangeGeneral<MaxComponents, Count>(system, K, q, components);
+}
+
 }  // namespace detail
 
 /// Cell-centred momentum exchange (Uintah addExch_Vel_Temp_CC, momentum part), in place.
@@ -207,7 +297,8 @@ KOKKOS_INLINE_FUNCTION ExchangeStatus implicitExchange(const ExchangeSystem& sys
 ///   velocity[m] [m/s], Dim components, replaced by the exchanged velocity.
 /// The symmetric form uses w_m = mass_density[m]; it equals Uintah's beta when
 /// mass_density = volume_fraction/specific_volume, as after the equilibration.
-template <int Dim>
+/// Count > 0: the number of materials fixed at compile time (count must equal it; see implicitExchange).
+template <int Dim, int Count = 0>
 KOKKOS_INLINE_FUNCTION ExchangeStatus exchangeMomentumCC(int count, double dt, const ExchangeCoefficients& K,
                                                          const MaterialArray<double>& mass_density,
                                                          const MaterialArray<double>& volume_fraction,
@@ -215,12 +306,14 @@ KOKKOS_INLINE_FUNCTION ExchangeStatus exchangeMomentumCC(int count, double dt, c
                                                          MaterialArray<Kokkos::Array<double, Dim>>& velocity)
 {
   if (count < 0 || count > kMaxMaterials) return ExchangeStatus::InvalidInput;
-  detail::ExchangeSystem system{count, mass_density, specific_volume, volume_fraction, dt};
+  if (Count > 0 && count != Count) return ExchangeStatus::InvalidInput;
+  const int n = Count > 0 ? Count : count;
+  detail::ExchangeSystem system{n, mass_density, specific_volume, volume_fraction, dt};
   double q[kMaxMaterials][Dim];
-  for (int m = 0; m < count; ++m)
+  for (int m = 0; m < n; ++m)
     for (int d = 0; d < Dim; ++d) q[m][d] = velocity[m][d];
-  const ExchangeStatus status = detail::implicitExchange<Dim>(system, K, q, Dim);
-  for (int m = 0; m < count; ++m)
+  const ExchangeStatus status = detail::implicitExchange<Dim, Count>(system, K, q, Dim);
+  for (int m = 0; m < n; ++m)
     for (int d = 0; d < Dim; ++d) velocity[m][d] = q[m][d];
   return status;
 }
@@ -255,6 +348,8 @@ KOKKOS_INLINE_FUNCTION ExchangeStatus exchangeHeatCC(int count, double dt, const
 /// on each material's face velocity after the exchange (the pressure equation's coefficient). One
 /// material, or K = 0, gives the harmonic mean itself; K -> infinity gives sum theta/sum(theta/v),
 /// the mixture's specific volume, for every material.
+/// Count > 0: the number of materials fixed at compile time, as for exchangeMomentumCC.
+template <int Count = 0>
 KOKKOS_INLINE_FUNCTION ExchangeStatus exchangeMomentumFC(int count, double dt, const ExchangeCoefficients& K,
                                                          const MaterialArray<double>& volume_fraction_left,
                                                          const MaterialArray<double>& volume_fraction_right,
@@ -264,9 +359,11 @@ KOKKOS_INLINE_FUNCTION ExchangeStatus exchangeMomentumFC(int count, double dt, c
                                                          MaterialArray<double>& face_specific_volume)
 {
   if (count < 0 || count > kMaxMaterials) return ExchangeStatus::InvalidInput;
-  detail::ExchangeSystem system{count, {}, {}, {}, dt};
+  if (Count > 0 && count != Count) return ExchangeStatus::InvalidInput;
+  const int n = Count > 0 ? Count : count;
+  detail::ExchangeSystem system{n, {}, {}, {}, dt};
   double q[kMaxMaterials][2];
-  for (int m = 0; m < count; ++m) {
+  for (int m = 0; m < n; ++m) {
     const double vl = specific_volume_left[m];
     const double vr = specific_volume_right[m];
     const double v = 2.0 * vl * vr / (vl + vr);
@@ -277,8 +374,8 @@ KOKKOS_INLINE_FUNCTION ExchangeStatus exchangeMomentumFC(int count, double dt, c
     q[m][0] = face_velocity[m];
     q[m][1] = v;
   }
-  const ExchangeStatus status = detail::implicitExchange<2>(system, K, q, 2);
-  for (int m = 0; m < count; ++m) {
+  const ExchangeStatus status = detail::implicitExchange<2, Count>(system, K, q, 2);
+  for (int m = 0; m < n; ++m) {
     face_velocity[m] = q[m][0];
     face_specific_volume[m] = q[m][1];
   }

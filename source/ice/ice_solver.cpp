@@ -11,6 +11,7 @@
 #include <cmath>
 #include <iomanip>
 #include <sstream>
+#include <type_traits>
 
 namespace cfdmpm {
 
@@ -41,6 +42,18 @@ KOKKOS_INLINE_FUNCTION double followMixtureVelocity(int n, LocalOrdinal c, const
     if (!(rho(c, m) > kNegligibleMassShare * mass))
       for (int d = 0; d < Dim; ++d) u(c, m * Dim + d) = momentum[d] / (mass + kTiny);
   return mass;
+}
+
+// Calls f(std::integral_constant<int, N>()): N = 2 for two materials, so that the kernels' loops over
+// materials have constant bounds (and the exchange takes its two-material form), else N = 0 (the
+// count is read at run time).
+template <class F>
+void forMaterialCount(int materials, F&& f)
+{
+  if (materials == 2)
+    f(std::integral_constant<int, 2>());
+  else
+    f(std::integral_constant<int, 0>());
 }
 
 }  // namespace
@@ -138,27 +151,32 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
   auto kappa = compressibility_.view();
   auto sum_kappa = mixture_compressibility_.view();
   int failures = 0;
-  Kokkos::parallel_reduce(
-      "ice::equilibrate", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
-      KOKKOS_LAMBDA(const LocalOrdinal c, int& failed) {
-        ice::MaterialArray<double> mass_density{}, temperature{};
-        for (int m = 0; m < n; ++m) {
-          mass_density[m] = rho(c, m) > 0 ? rho(c, m) : 0.0;
-          temperature[m] = T(c, m);
-        }
-        const ice::EquilibrationResult r = ice::equilibrationPressure(n, eos, mass_density, temperature, p(c, 0));
-        if (!r.converged()) ++failed;
-        p(c, 0) = r.pressure;
-        double sk = 0;
-        for (int m = 0; m < n; ++m) {
-          theta(c, m) = r.volume_fraction[m];
-          v(c, m) = 1.0 / r.density[m];
-          kappa(c, m) = r.compressibility[m];
-          sk += r.volume_fraction[m] * r.compressibility[m];
-        }
-        sum_kappa(c, 0) = sk;
-      },
-      failures);
+  forMaterialCount(n, [&](auto count) {
+    constexpr int N = decltype(count)::value;
+    Kokkos::parallel_reduce(
+        "ice::equilibrate", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+        KOKKOS_LAMBDA(const LocalOrdinal c, int& failed) {
+          const int nm = N > 0 ? N : n;
+          ice::MaterialArray<double> mass_density{}, temperature{};
+          for (int m = 0; m < nm; ++m) {
+            mass_density[m] = rho(c, m) > 0 ? rho(c, m) : 0.0;
+            temperature[m] = T(c, m);
+          }
+          const ice::EquilibrationResult r =
+              ice::equilibrationPressure<N>(nm, eos, mass_density, temperature, p(c, 0));
+          if (!r.converged()) ++failed;
+          p(c, 0) = r.pressure;
+          double sk = 0;
+          for (int m = 0; m < nm; ++m) {
+            theta(c, m) = r.volume_fraction[m];
+            v(c, m) = 1.0 / r.density[m];
+            kappa(c, m) = r.compressibility[m];
+            sk += r.volume_fraction[m] * r.compressibility[m];
+          }
+          sum_kappa(c, 0) = sk;
+        },
+        failures);
+  });
   for (Field<Dim>* f : {&state.volume_fraction, &state.specific_volume, &state.pressure, &compressibility_,
                         &mixture_compressibility_})
     f->exchangeHalo();
@@ -167,9 +185,11 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
   return total;
 }
 
-// [4] Face velocities before exchange: the density-weighted average of the two cells, accelerated
-// by the pressure difference (harmonic-mean specific volume) and gravity (Kashiwa; Uintah
-// computeVel_FC). Stored on the lower face of each owned cell; domain faces stay zero (walls).
+// [4] Face velocities: the density-weighted average of the two cells, accelerated by the pressure
+// difference (harmonic-mean specific volume) and gravity (Kashiwa; Uintah computeVel_FC), then the
+// implicit face momentum exchange and the face specific volume the pressure equation uses (Uintah
+// vel_FC_exchange). One pass per direction; stored on the lower face of each owned cell. Domain
+// faces stay zero (walls).
 template <int Dim>
 void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
 {
@@ -177,77 +197,59 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
   const auto neighbours = layout_->cellNeighbours();
   const auto rho = state.density.view();
   const auto u = state.velocity.view();
-  const auto v = state.specific_volume.view();
-  const auto p = state.pressure.view();
-  for (int d = 0; d < Dim; ++d) {
-    auto uf = face_velocity_.direction(d).view();
-    const double h = layout_->grid().spacing()[d];
-    const double g = gravity_[d];
-    Kokkos::parallel_for(
-        "ice::faceVelocities", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
-        KOKKOS_LAMBDA(const LocalOrdinal c) {
-          const LocalOrdinal l = neighbours(c, 2 * d);
-          for (int m = 0; m < n; ++m) {
-            if (l < 0) {
-              uf(c, m) = 0.0;
-              continue;
-            }
-            const double rl = rho(l, m), rr = rho(c, m);
-            const double ul = u(l, m * Dim + d), ur = u(c, m * Dim + d);
-            const double mean = (rl * ul + rr * ur) / (rl + rr + kTiny);
-            const double vbar = 2.0 * v(l, m) * v(c, m) / (v(l, m) + v(c, m));
-            uf(c, m) = mean - dt * vbar * (p(c, 0) - p(l, 0)) / h + dt * g;
-          }
-        });
-  }
-}
-
-// [4] Implicit face momentum exchange and the face specific volume the pressure equation uses.
-template <int Dim>
-void IceSolver<Dim>::faceExchange(const CellState<Dim>& state, double dt)
-{
-  const int n = materials_;
-  const auto neighbours = layout_->cellNeighbours();
   const auto theta = state.volume_fraction.view();
   const auto v = state.specific_volume.view();
+  const auto p = state.pressure.view();
   const auto K = ice::ExchangeCoefficients::uniform(settings_.exchange_coefficient);
-  for (int d = 0; d < Dim; ++d) {
-    auto uf = face_velocity_.direction(d).view();
-    auto vf = face_specific_volume_.direction(d).view();
-    auto beta = face_beta_.direction(d).view();
-    Kokkos::parallel_for(
-        "ice::faceExchange", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
-        KOKKOS_LAMBDA(const LocalOrdinal c) {
-          const LocalOrdinal l = neighbours(c, 2 * d);
-          if (l < 0) {
-            for (int m = 0; m < n; ++m) vf(c, m) = 0.0;
-            beta(c, 0) = 0.0;
-            return;
-          }
-          ice::MaterialArray<double> tl{}, tr{}, vl{}, vr{}, vel{}, sv{};
-          for (int m = 0; m < n; ++m) {
-            tl[m] = theta(l, m), tr[m] = theta(c, m), vl[m] = v(l, m), vr[m] = v(c, m), vel[m] = uf(c, m);
-          }
-          ice::exchangeMomentumFC(n, dt, K, tl, tr, vl, vr, vel, sv);
-          // A material absent on both sides has no weight in the exchange and would keep its own
-          // acceleration (for air inside water, v_air ∇p ~ 800 g); it moves with the mixture instead,
-          // whose specific volume is β = Σ θ_f v_f (Σ θ_f = 1).
-          double b = 0, weight = 0, momentum = 0;
-          for (int m = 0; m < n; ++m) {
-            const double w = (tl[m] + tr[m]) / sv[m];
-            weight += w;
-            momentum += w * vel[m];
-            b += 0.5 * (tl[m] + tr[m]) * sv[m];
-          }
-          const double mixture = momentum / (weight + kTiny);
-          for (int m = 0; m < n; ++m) {
-            const bool present = tl[m] + tr[m] > 2 * kNegligibleVolumeShare;
-            uf(c, m) = present ? vel[m] : mixture;
-            vf(c, m) = present ? sv[m] : b;  // and follows the mixture's pressure correction
-          }
-          beta(c, 0) = b;
-        });
-  }
+  forMaterialCount(n, [&](auto count) {
+    constexpr int N = decltype(count)::value;
+    for (int d = 0; d < Dim; ++d) {
+      auto uf = face_velocity_.direction(d).view();
+      auto vf = face_specific_volume_.direction(d).view();
+      auto beta = face_beta_.direction(d).view();
+      const double h = layout_->grid().spacing()[d];
+      const double g = gravity_[d];
+      Kokkos::parallel_for(
+          "ice::faceVelocities", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+          KOKKOS_LAMBDA(const LocalOrdinal c) {
+            const int nm = N > 0 ? N : n;
+            const LocalOrdinal l = neighbours(c, 2 * d);
+            if (l < 0) {
+              for (int m = 0; m < nm; ++m) uf(c, m) = 0.0, vf(c, m) = 0.0;
+              beta(c, 0) = 0.0;
+              return;
+            }
+            const double pressure_difference = p(c, 0) - p(l, 0);
+            ice::MaterialArray<double> tl{}, tr{}, vl{}, vr{}, vel{}, sv{};
+            for (int m = 0; m < nm; ++m) {
+              tl[m] = theta(l, m), tr[m] = theta(c, m), vl[m] = v(l, m), vr[m] = v(c, m);
+              const double rl = rho(l, m), rr = rho(c, m);
+              const double ul = u(l, m * Dim + d), ur = u(c, m * Dim + d);
+              const double mean = (rl * ul + rr * ur) / (rl + rr + kTiny);
+              const double vbar = 2.0 * vl[m] * vr[m] / (vl[m] + vr[m]);
+              vel[m] = mean - dt * vbar * pressure_difference / h + dt * g;
+            }
+            ice::exchangeMomentumFC<N>(nm, dt, K, tl, tr, vl, vr, vel, sv);
+            // A material absent on both sides has no weight in the exchange and would keep its own
+            // acceleration (for air inside water, v_air ∇p ~ 800 g); it moves with the mixture
+            // instead, whose specific volume is β = Σ θ_f v_f (Σ θ_f = 1).
+            double b = 0, weight = 0, momentum = 0;
+            for (int m = 0; m < nm; ++m) {
+              const double w = (tl[m] + tr[m]) / sv[m];
+              weight += w;
+              momentum += w * vel[m];
+              b += 0.5 * (tl[m] + tr[m]) * sv[m];
+            }
+            const double mixture = momentum / (weight + kTiny);
+            for (int m = 0; m < nm; ++m) {
+              const bool present = tl[m] + tr[m] > 2 * kNegligibleVolumeShare;
+              uf(c, m) = present ? vel[m] : mixture;
+              vf(c, m) = present ? sv[m] : b;  // and follows the mixture's pressure correction
+            }
+            beta(c, 0) = b;
+          });
+    }
+  });
   face_velocity_.exchangeHalo();
   face_specific_volume_.exchangeHalo();
   face_beta_.exchangeHalo();
@@ -319,12 +321,15 @@ void IceSolver<Dim>::correctFaceVelocities(double dt)
   face_velocity_.exchangeHalo();
 }
 
-// [6] + [8] Momentum sources and Lagrangian values. Face pressure p_f weighted by the summed
+// [6] + [8] Momentum sources and Lagrangian values, then the implicit cell-centred momentum exchange
+// (Uintah addExch_Vel_Temp_CC, momentum part), in one pass. Face pressure p_f weighted by the summed
 // densities of the two cells (Uintah computePressFC); force on material m: −θ_m V ∇p_f, Newtonian
 // viscous stress (θ μ ∇²u per material), gravity. The Lagrangian specific volume follows the pressure
-// change: v_L = v (1 − κ_m Σδp) (Uintah computeLagrangianSpecificVolume, isothermal).
+// change: v_L = v (1 − κ_m Σδp) (Uintah computeLagrangianSpecificVolume, isothermal). The exchange is
+// pointwise, so it acts on the cell's new velocities before they are stored; a material with a
+// negligible share of the mass then takes the mixture's velocity.
 template <int Dim>
-void IceSolver<Dim>::momentumAndLagrangianValues(CellState<Dim>& state, double dt)
+void IceSolver<Dim>::momentumAndExchange(CellState<Dim>& state, double dt)
 {
   const int n = materials_;
   const auto neighbours = layout_->cellNeighbours();
@@ -336,86 +341,85 @@ void IceSolver<Dim>::momentumAndLagrangianValues(CellState<Dim>& state, double d
   auto u = state.velocity.view();
   auto v = state.specific_volume.view();
   const auto mu = viscosity_;
+  const auto K = ice::ExchangeCoefficients::uniform(settings_.exchange_coefficient);
   double h[3], g[3];
   int no_slip[6];
   for (int d = 0; d < Dim; ++d) h[d] = layout_->grid().spacing()[d], g[d] = gravity_[d];
   for (int f = 0; f < 2 * Dim; ++f) no_slip[f] = wall_no_slip_[f];
   // New velocities go to a copy so that the viscous stencil reads old values only.
   auto un = new_velocity_.view();
-  Kokkos::parallel_for(
-      "ice::momentumSources", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
-      KOKKOS_LAMBDA(const LocalOrdinal c) {
-        double sum_rho_c = 0;
-        for (int m = 0; m < n; ++m) sum_rho_c += rho(c, m);
-        double grad_p[3] = {0, 0, 0};
-        for (int d = 0; d < Dim; ++d) {
-          double face_p[2];
-          for (int side = 0; side < 2; ++side) {
-            const LocalOrdinal o = neighbours(c, 2 * d + side);
-            if (o < 0) {
-              // Wall: the pressure's normal gradient is the hydrostatic one (dp/dn = ρ g·n), so a
-              // fluid at rest next to a wall feels no net force.
-              face_p[side] = p(c, 0) + (side == 0 ? -0.5 : 0.5) * h[d] * sum_rho_c * g[d];
-              continue;
-            }
-            double sum_rho_o = 0;
-            for (int m = 0; m < n; ++m) sum_rho_o += rho(o, m);
-            face_p[side] = (p(o, 0) * sum_rho_c + p(c, 0) * sum_rho_o) / (sum_rho_c + sum_rho_o + kTiny);
-          }
-          grad_p[d] = (face_p[1] - face_p[0]) / h[d];
-        }
-        for (int m = 0; m < n; ++m) {
-          const double r = rho(c, m);
-          for (int k = 0; k < Dim; ++k) {
-            // Viscous force per volume: θ_m μ_m ∇²u_k, so that the acceleration is ν_m ∇²u_k whatever
-            // the material's share of the cell (a face-averaged θ would blow up where θ_c -> 0).
-            double viscous = 0;
-            for (int d = 0; d < Dim; ++d)
-              for (int side = 0; side < 2; ++side) {
-                const int f = 2 * d + side;
-                const LocalOrdinal o = neighbours(c, f);
-                if (o >= 0) {
-                  viscous += mu[m] * theta(c, m) * (u(o, m * Dim + k) - u(c, m * Dim + k)) / (h[d] * h[d]);
-                } else if (no_slip[f] && k != d) {
-                  viscous -= mu[m] * theta(c, m) * 2.0 * u(c, m * Dim + k) / (h[d] * h[d]);
-                }
+  forMaterialCount(n, [&](auto count) {
+    constexpr int N = decltype(count)::value;
+    Kokkos::parallel_for(
+        "ice::momentumSources", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+        KOKKOS_LAMBDA(const LocalOrdinal c) {
+          const int nm = N > 0 ? N : n;
+          LocalOrdinal neighbour[2 * Dim];
+          for (int f = 0; f < 2 * Dim; ++f) neighbour[f] = neighbours(c, f);
+          ice::MaterialArray<double> r{}, t{}, s{};
+          for (int m = 0; m < nm; ++m) r[m] = rho(c, m), t[m] = theta(c, m);
+          double sum_rho_c = 0;
+          for (int m = 0; m < nm; ++m) sum_rho_c += r[m];
+          double grad_p[3] = {0, 0, 0};
+          for (int d = 0; d < Dim; ++d) {
+            double face_p[2];
+            for (int side = 0; side < 2; ++side) {
+              const LocalOrdinal o = neighbour[2 * d + side];
+              if (o < 0) {
+                // Wall: the pressure's normal gradient is the hydrostatic one (dp/dn = ρ g·n), so a
+                // fluid at rest next to a wall feels no net force.
+                face_p[side] = p(c, 0) + (side == 0 ? -0.5 : 0.5) * h[d] * sum_rho_c * g[d];
+                continue;
               }
-            const double force = -theta(c, m) * grad_p[k] + viscous + r * g[k];  // per volume
-            un(c, m * Dim + k) = r > 0 ? u(c, m * Dim + k) + dt * force / r : u(c, m * Dim + k);
+              double sum_rho_o = 0;
+              for (int m = 0; m < nm; ++m) sum_rho_o += rho(o, m);
+              face_p[side] = (p(o, 0) * sum_rho_c + p(c, 0) * sum_rho_o) / (sum_rho_c + sum_rho_o + kTiny);
+            }
+            grad_p[d] = (face_p[1] - face_p[0]) / h[d];
           }
-          v(c, m) = v(c, m) * (1.0 - kappa(c, m) * sum_dp(c, 0));
-        }
-      });
+          ice::MaterialArray<Kokkos::Array<double, Dim>> vel{};
+          for (int m = 0; m < nm; ++m) {
+            for (int k = 0; k < Dim; ++k) {
+              const double uc = u(c, m * Dim + k);
+              // Viscous force per volume: θ_m μ_m ∇²u_k, so that the acceleration is ν_m ∇²u_k
+              // whatever the material's share of the cell (a face-averaged θ would blow up where
+              // θ_c -> 0).
+              double viscous = 0;
+              for (int d = 0; d < Dim; ++d)
+                for (int side = 0; side < 2; ++side) {
+                  const int f = 2 * d + side;
+                  const LocalOrdinal o = neighbour[f];
+                  if (o >= 0) {
+                    viscous += mu[m] * t[m] * (u(o, m * Dim + k) - uc) / (h[d] * h[d]);
+                  } else if (no_slip[f] && k != d) {
+                    viscous -= mu[m] * t[m] * 2.0 * uc / (h[d] * h[d]);
+                  }
+                }
+              const double force = -t[m] * grad_p[k] + viscous + r[m] * g[k];  // per volume
+              vel[m][k] = r[m] > 0 ? uc + dt * force / r[m] : uc;
+            }
+            s[m] = v(c, m) * (1.0 - kappa(c, m) * sum_dp(c, 0));
+            v(c, m) = s[m];
+          }
+          ice::exchangeMomentumCC<Dim, N>(nm, dt, K, r, t, s, vel);
+          // A material with a negligible share of the mass takes the mixture's velocity (as
+          // followMixtureVelocity, on the cell's new values).
+          double mass = 0, momentum[3] = {0, 0, 0};
+          for (int m = 0; m < nm; ++m) {
+            mass += r[m];
+            for (int d = 0; d < Dim; ++d) momentum[d] += r[m] * vel[m][d];
+          }
+          for (int m = 0; m < nm; ++m) {
+            const bool negligible = !(r[m] > kNegligibleMassShare * mass);
+            for (int d = 0; d < Dim; ++d)
+              un(c, m * Dim + d) = negligible ? momentum[d] / (mass + kTiny) : vel[m][d];
+          }
+        });
+  });
   Kokkos::parallel_for(
       "ice::copyVelocity", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
       KOKKOS_LAMBDA(const LocalOrdinal c) {
         for (int k = 0; k < n * Dim; ++k) u(c, k) = un(c, k);
-      });
-}
-
-// [8] Implicit cell-centred momentum exchange (Uintah addExch_Vel_Temp_CC, momentum part).
-template <int Dim>
-void IceSolver<Dim>::cellExchange(CellState<Dim>& state, double dt)
-{
-  const int n = materials_;
-  const auto theta = state.volume_fraction.view();
-  const auto rho = state.density.view();
-  const auto v = state.specific_volume.view();
-  auto u = state.velocity.view();
-  const auto K = ice::ExchangeCoefficients::uniform(settings_.exchange_coefficient);
-  Kokkos::parallel_for(
-      "ice::cellExchange", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
-      KOKKOS_LAMBDA(const LocalOrdinal c) {
-        ice::MaterialArray<double> r{}, t{}, s{};
-        ice::MaterialArray<Kokkos::Array<double, Dim>> vel{};
-        for (int m = 0; m < n; ++m) {
-          r[m] = rho(c, m), t[m] = theta(c, m), s[m] = v(c, m);
-          for (int d = 0; d < Dim; ++d) vel[m][d] = u(c, m * Dim + d);
-        }
-        ice::exchangeMomentumCC<Dim>(n, dt, K, r, t, s, vel);
-        for (int m = 0; m < n; ++m)
-          for (int d = 0; d < Dim; ++d) u(c, m * Dim + d) = vel[m][d];
-        followMixtureVelocity<Dim>(n, c, rho, u);
       });
 }
 
@@ -488,7 +492,6 @@ IceStepReport IceSolver<Dim>::step(CellState<Dim>& state, double dt)
     state.velocity.exchangeHalo();
     state.density.exchangeHalo();
     faceVelocities(state, dt);
-    faceExchange(state, dt);
   }
 
   // [5] Pressure correction with outer iterations (implicit), or one explicit update.
@@ -570,8 +573,7 @@ IceStepReport IceSolver<Dim>::step(CellState<Dim>& state, double dt)
       Kokkos::deep_copy(old_specific_volume_.view(), state.specific_volume.view());
       state.temperature.exchangeHalo();
     }
-    momentumAndLagrangianValues(state, dt);
-    cellExchange(state, dt);
+    momentumAndExchange(state, dt);
     if (!settings_.isothermal) energy(state, old_specific_volume_, dt);
   }
 
@@ -593,17 +595,21 @@ IceStepReport IceSolver<Dim>::step(CellState<Dim>& state, double dt)
     const auto v = state.specific_volume.view();
     const auto cv = specific_heat_;
     const int n = materials_;
-    Kokkos::parallel_for(
-        "ice::closeCells", Kokkos::RangePolicy<ExecutionSpace>(0, state.density.overlapCount()),
-        KOKKOS_LAMBDA(const LocalOrdinal c) {
-          for (int m = 0; m < n; ++m) theta(c, m) = rho(c, m) * v(c, m);
-          const double mass = followMixtureVelocity<Dim>(n, c, rho, u);
-          double heat = 0, capacity = 0;
-          for (int m = 0; m < n; ++m) heat += rho(c, m) * cv[m] * T(c, m), capacity += rho(c, m) * cv[m];
-          if (capacity > 0)
-            for (int m = 0; m < n; ++m)
-              if (!(rho(c, m) > kNegligibleMassShare * mass)) T(c, m) = heat / capacity;
-        });
+    forMaterialCount(n, [&](auto count) {
+      constexpr int N = decltype(count)::value;
+      Kokkos::parallel_for(
+          "ice::closeCells", Kokkos::RangePolicy<ExecutionSpace>(0, state.density.overlapCount()),
+          KOKKOS_LAMBDA(const LocalOrdinal c) {
+            const int nm = N > 0 ? N : n;
+            for (int m = 0; m < nm; ++m) theta(c, m) = rho(c, m) * v(c, m);
+            const double mass = followMixtureVelocity<Dim>(nm, c, rho, u);
+            double heat = 0, capacity = 0;
+            for (int m = 0; m < nm; ++m) heat += rho(c, m) * cv[m] * T(c, m), capacity += rho(c, m) * cv[m];
+            if (capacity > 0)
+              for (int m = 0; m < nm; ++m)
+                if (!(rho(c, m) > kNegligibleMassShare * mass)) T(c, m) = heat / capacity;
+          });
+    });
   }
   return report;
 }

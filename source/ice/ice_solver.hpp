@@ -90,11 +90,9 @@ class IceSolver {
 
  private:
   void faceVelocities(const CellState<Dim>& state, double dt);
-  void faceExchange(const CellState<Dim>& state, double dt);
   double pressureRightHandSide(const CellState<Dim>& state, double dt);
   void correctFaceVelocities(double dt);
-  void momentumAndLagrangianValues(CellState<Dim>& state, double dt);
-  void cellExchange(CellState<Dim>& state, double dt);
+  void momentumAndExchange(CellState<Dim>& state, double dt);
   void energy(CellState<Dim>& state, const Field<Dim>& old_specific_volume, double dt);
 
   Scene scene_;

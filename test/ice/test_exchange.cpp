@@ -408,3 +408,69 @@ TEST(Exchange, ReportsMaterialCountOutOfRange)
                                   cell.mass_density, cell.volume_fraction, cell.specific_volume, cell.velocity),
             ExchangeStatus::InvalidInput);
 }
+
+TEST(Exchange, TwoMaterialFormIsTheGeneralEliminationBitForBit)
+{
+  // The kernels call the exchange with the material count fixed at compile time; for two materials
+  // that is a written-out elimination, which must give the general one's results to the bit: both
+  // present, one or both without mass, K = 0, 1e3 and 1e15 (with denormal-scale volume fractions),
+  // and non-finite input.
+  unsigned state = 12345;
+  const auto uniform = [&state](double lo, double hi) {
+    state = state * 1664525u + 1013904223u;
+    return lo + (hi - lo) * double(state >> 8) / double(1u << 24);
+  };
+  const double coefficients[3] = {0.0, 1e3, 1e15};
+  int cases = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const double K = coefficients[trial % 3];
+    const double dt = uniform(1e-6, 1e-3);
+    MaterialArray<double> theta{}, v{}, rho{};
+    MaterialArray<Velocity2> u{};
+    for (int m = 0; m < 2; ++m) {
+      const int kind = (trial / 3 + m) % 5;  // 0: without mass; 1: a trace; else a share of the cell
+      theta[m] = kind == 0 ? 0.0 : kind == 1 ? uniform(1e-300, 1e-12) : uniform(0.0, 1.0);
+      v[m] = m == 0 ? uniform(9e-4, 1.1e-3) : uniform(0.7, 0.9);
+      rho[m] = theta[m] / v[m];
+      u[m] = {uniform(-3.0, 3.0), trial % 7 == 0 ? -0.0 : uniform(-3.0, 3.0)};
+    }
+    if (trial % 97 == 0) u[trial % 2][1] = std::nan("");
+    MaterialArray<Velocity2> general = u, two = u;
+    const ExchangeStatus s_general =
+        exchangeMomentumCC<2>(2, dt, ExchangeCoefficients::uniform(K), rho, theta, v, general);
+    const ExchangeStatus s_two =
+        exchangeMomentumCC<2, 2>(2, dt, ExchangeCoefficients::uniform(K), rho, theta, v, two);
+    ASSERT_EQ(s_general, s_two) << "trial " << trial;
+    if (s_general == ExchangeStatus::Ok)
+      for (int m = 0; m < 2; ++m)
+        for (int d = 0; d < 2; ++d) {
+          ASSERT_EQ(std::signbit(general[m][d]), std::signbit(two[m][d])) << "trial " << trial;
+          ASSERT_EQ(general[m][d], two[m][d]) << "trial " << trial << ", material " << m << ", component " << d;
+        }
+
+    MaterialArray<double> theta_r{}, v_r{}, uf{}, vf_general{}, vf_two{};
+    for (int m = 0; m < 2; ++m) {
+      theta_r[m] = (trial / 5) % 3 == 0 ? 0.0 : uniform(0.0, 1.0);
+      v_r[m] = v[m] * uniform(0.99, 1.01);
+      uf[m] = u[m][0];
+    }
+    MaterialArray<double> uf_general = uf, uf_two = uf;
+    const ExchangeStatus f_general = exchangeMomentumFC(2, dt, ExchangeCoefficients::uniform(K), theta, theta_r, v,
+                                                        v_r, uf_general, vf_general);
+    const ExchangeStatus f_two = exchangeMomentumFC<2>(2, dt, ExchangeCoefficients::uniform(K), theta, theta_r, v,
+                                                       v_r, uf_two, vf_two);
+    ASSERT_EQ(f_general, f_two) << "trial " << trial;
+    if (f_general == ExchangeStatus::Ok)
+      for (int m = 0; m < 2; ++m) {
+        ASSERT_EQ(uf_general[m], uf_two[m]) << "trial " << trial;
+        ASSERT_EQ(vf_general[m], vf_two[m]) << "trial " << trial;
+      }
+    ++cases;
+  }
+  EXPECT_EQ(cases, 3000);
+  // A count that is not the compiled one is refused.
+  MaterialArray<double> theta{}, v{}, rho{};
+  MaterialArray<Velocity2> u{};
+  EXPECT_EQ((exchangeMomentumCC<2, 2>(3, 1e-4, ExchangeCoefficients::uniform(1e15), rho, theta, v, u)),
+            ExchangeStatus::InvalidInput);
+}

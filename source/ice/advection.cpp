@@ -378,6 +378,19 @@ void Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, double dt, 
       "advection slabs", Kokkos::RangePolicy<ExecutionSpace>(0, cells), KOKKOS_LAMBDA(int c) {
         const auto local = stencil.local(c);
         for (int m = 0; m < materials; ++m) {
+          if (M(c, m) == 0.0) {
+            // No mass of m here: nothing leaves (masses are >= 0, so the block's lower bound is 0
+            // and the limiter sets the slope to 0: every slab would carry exactly 0). The slab
+            // values then weigh nothing; only the block bounds of q are needed, to bound q where
+            // mass flows in.
+            for (int f = 0; f < 2 * Dim; ++f) outflow_mass(c, f, m) = 0.0;
+            for (int field = 0; field < q.fields; ++field)
+              for (int j = 0; j < q.width[field]; ++j) {
+                const int col = m * q.width[field] + j, slot = q.first[field] + col;
+                stencil.blockBounds(q.field[field], c, local, col, bounds(c, slot, 0), bounds(c, slot, 1));
+              }
+            continue;
+          }
           double fraction[2 * Dim], r[2 * Dim][Dim];
           slabs.cellSlabs(c, m, local.neighbour, fraction, r);
           double g[Dim], spread = 0;

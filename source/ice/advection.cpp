@@ -382,8 +382,14 @@ void Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, double dt, 
             // No mass of m here: nothing leaves (masses are >= 0, so the block's lower bound is 0
             // and the limiter sets the slope to 0: every slab would carry exactly 0). The slab
             // values then weigh nothing; only the block bounds of q are needed, to bound q where
-            // mass flows in.
-            for (int f = 0; f < 2 * Dim; ++f) outflow_mass(c, f, m) = 0.0;
+            // mass flows in, which needs a face neighbour with mass (update() skips the rest).
+            bool inflow_possible = false;
+            for (int f = 0; f < 2 * Dim; ++f) {
+              outflow_mass(c, f, m) = 0.0;
+              const LocalOrdinal n = local.neighbour[f];
+              inflow_possible = inflow_possible || (n >= 0 && M(n, m) != 0.0);
+            }
+            if (!inflow_possible) continue;
             for (int field = 0; field < q.fields; ++field)
               for (int j = 0; j < q.width[field]; ++j) {
                 const int col = m * q.width[field] + j, slot = q.first[field] + col;
@@ -476,6 +482,12 @@ void Advector<Dim>::update(Field<Dim>& mass, const std::vector<Field<Dim>*>& mas
             out[f] = outflow_mass(c, f, m);
             mass_new += in[f] - out[f];
           }
+          // Without mass before and without inflow the cell keeps no mass and its q as it is (the
+          // clamp below would leave q unchanged too: the block bounds include the cell's own q);
+          // reconstruct() computed no bounds for it.
+          bool inflow = false;
+          for (int f = 0; f < 2 * Dim; ++f) inflow = inflow || in[f] != 0.0;
+          if (M(c, m) == 0.0 && !inflow) continue;
           for (int field = 0; field < q.fields; ++field) {
             const auto& Q = q.field[field];
             for (int j = 0; j < q.width[field]; ++j) {

@@ -381,6 +381,10 @@ void IceSolver<Dim>::momentumAndExchange(CellState<Dim>& state, double dt)
           for (int m = 0; m < nm; ++m) {
             for (int k = 0; k < Dim; ++k) {
               const double uc = u(c, m * Dim + k);
+              if (!(r[m] > 0)) {  // no mass of m here: no force to apply
+                vel[m][k] = uc;
+                continue;
+              }
               // Viscous force per volume: θ_m μ_m ∇²u_k, so that the acceleration is ν_m ∇²u_k
               // whatever the material's share of the cell (a face-averaged θ would blow up where
               // θ_c -> 0).
@@ -396,7 +400,7 @@ void IceSolver<Dim>::momentumAndExchange(CellState<Dim>& state, double dt)
                   }
                 }
               const double force = -t[m] * grad_p[k] + viscous + r[m] * g[k];  // per volume
-              vel[m][k] = r[m] > 0 ? uc + dt * force / r[m] : uc;
+              vel[m][k] = uc + dt * force / r[m];
             }
             s[m] = v(c, m) * (1.0 - kappa(c, m) * sum_dp(c, 0));
             v(c, m) = s[m];

@@ -156,12 +156,6 @@ struct Slabs {
   }
 };
 
-/// The limiter factor in [0, 1] for a linear profile value + φ g·r in one cell.
-/// 1. Barth–Jespersen: the profile stays within [lo, hi] (the cell's 3^Dim block) everywhere in the
-///    cell; `spread` = Σ_d |g_d| Δx_d / 2 is the largest excursion from the centre value.
-/// 2. Remainder bound: what stays in the cell after the outflow slabs leave has the mean
-///    value - φ·S / remaining, which must also lie within [lo, hi]; S = Σ_out w_f g·r_f with the
-///    slabs' weights w_f, and `remaining` = weight left in the cell (>= 0).
 /// The largest outflow fraction Σ_faces V_out / V_cell over cells and materials, and among the
 /// entries that attain it the lowest key = global cell id · materials + material (so that every
 /// decomposition names the same cell): one reduction over the cells.
@@ -200,6 +194,12 @@ struct LargestOutflowReduction {
   }
 };
 
+/// The limiter factor in [0, 1] for a linear profile value + φ g·r in one cell.
+/// 1. Barth–Jespersen: the profile stays within [lo, hi] (the cell's 3^Dim block) everywhere in the
+///    cell; `spread` = Σ_d |g_d| Δx_d / 2 is the largest excursion from the centre value.
+/// 2. Remainder bound: what stays in the cell after the outflow slabs leave has the mean
+///    value - φ·S / remaining, which must also lie within [lo, hi]; S = Σ_out w_f g·r_f with the
+///    slabs' weights w_f, and `remaining` = weight left in the cell (>= 0).
 KOKKOS_INLINE_FUNCTION double limiter(double value, double lo, double hi, double spread, double remaining,
                                       double S)
 {

@@ -4,7 +4,8 @@
 #   - the dam break, 50 x 20 cells to 0.05 s, pressure solved to a relative residual of 1e-12;
 #   - the dry granular column (Drucker-Prager sand), 160 x 60 cells to 0.02 s.
 # Threads change only the order of sums: reductions (dot products in CG, diagnostics) and the
-# atomic particle-to-grid scatter. Each differs from the serial sum by round-off (~1e-16 relative);
+# particle-to-grid scatter (tile colour by tile colour on threads). Each differs from the serial
+# sum by round-off (~1e-16 relative);
 # CG turns that into differences at the linear solver's tolerance per solve, as between 1 and 2
 # MPI ranks, so the bound is the same as the 1-vs-2-rank tests': 1e-10 of each field's scale.
 #

@@ -1,7 +1,5 @@
 #include "mpm/mpm_solver.hpp"
 
-#include <Kokkos_ScatterView.hpp>
-
 #include "common/mpi_comm.hpp"
 #include "mpm/shape_functions.hpp"
 
@@ -274,7 +272,7 @@ void MpmSolver<Dim>::gridToParticles(double dt)
 /// P2G: m_i = sum_p w_ip m_p, (mv)_i = sum_p w_ip m_p v_p,
 ///      f_i = sum_p (-V_p sigma_p grad w_ip + w_ip m_p g)   (internal + external force),
 ///      grad m_i = sum_p m_p grad w_ip                       (material normals for contact),
-/// per material, scattered with atomics (race-free on threads), then summed across ranks.
+/// per material, scattered race-free on threads (ParticleBins), then summed across ranks.
 template <int Dim>
 template <class Kernel>
 void MpmSolver<Dim>::particlesToGridWith()
@@ -298,44 +296,46 @@ void MpmSolver<Dim>::particlesToGridWith()
     nodes[d] = grid.nodes()[d];
   }
   Kokkos::View<int, MemorySpace> missing("nodes missing from the overlap");
+  const auto sums = node_sums_->view();
+  const auto scatter = KOKKOS_LAMBDA(const int p)
   {
-    // The scatter goes through a ScatterView: on Serial it is the plain view, on OpenMP each
-    // thread adds into its own copy and contribute() sums the copies (measured against atomic adds
-    // on doubles, which made P2G 4.7x slower on one OpenMP thread than on Serial; doc/threads.md).
-    auto sums_view = node_sums_->view();
-    auto scatter = Kokkos::Experimental::create_scatter_view(sums_view);
-    Kokkos::parallel_for(
-        "mpm::particles_to_grid", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count), KOKKOS_LAMBDA(const int p) {
-          double xp[Dim], lp[Dim];
-          for (int d = 0; d < Dim; ++d) xp[d] = x(p, d), lp[d] = half_width(p, d);
-          ShapeStencil<Dim, Kernel> s;
-          evaluateShape(xp, origin, spacing, lp, s);
-          const int m = material(p);
-          const double mp = mass(p), Vp = volume(p);
-          auto sums = scatter.access();
-          for (int k = 0; k < s.size; ++k) {
-            long long node[3] = {0, 0, 0};
-            s.node(k, node);
-            const LocalOrdinal lid = lookup(node[0], node[1], node[2]);
-            if (lid < 0) {
-              bool inside = true;
-              for (int d = 0; d < Dim; ++d) inside = inside && node[d] >= 0 && node[d] < nodes[d];
-              if (inside && s.weight[k] > 0.0) Kokkos::atomic_add(&missing(), 1);
-              continue;  // outside the grid: the part of the particle beyond the wall
-            }
-            const double w = s.weight[k];
-            sums(lid, col.mass(m)) += w * mp;
-            for (int d = 0; d < Dim; ++d) {
-              double internal = 0.0;
-              for (int e = 0; e < Dim; ++e) internal -= sigma(p, d, e) * s.gradient[k][e];
-              sums(lid, col.momentum(m, d)) += w * mp * v(p, d);
-              sums(lid, col.force(m, d)) += Vp * internal + w * mp * g[d];
-              // grad m(x_i) = sum_p m_p dS(x_i - x_p)/dx_i = -sum_p m_p dw_ip/dx_p
-              if (gradients) sums(lid, col.massGradient(m, d)) += -mp * s.gradient[k][d];
-            }
-          }
-        });
-    Kokkos::Experimental::contribute(sums_view, scatter);
+    double xp[Dim], lp[Dim];
+    for (int d = 0; d < Dim; ++d) xp[d] = x(p, d), lp[d] = half_width(p, d);
+    ShapeStencil<Dim, Kernel> s;
+    evaluateShape(xp, origin, spacing, lp, s);
+    const int m = material(p);
+    const double mp = mass(p), Vp = volume(p);
+    for (int k = 0; k < s.size; ++k) {
+      long long node[3] = {0, 0, 0};
+      s.node(k, node);
+      const LocalOrdinal lid = lookup(node[0], node[1], node[2]);
+      if (lid < 0) {
+        bool inside = true;
+        for (int d = 0; d < Dim; ++d) inside = inside && node[d] >= 0 && node[d] < nodes[d];
+        if (inside && s.weight[k] > 0.0) Kokkos::atomic_add(&missing(), 1);
+        continue;  // outside the grid: the part of the particle beyond the wall
+      }
+      const double w = s.weight[k];
+      sums(lid, col.mass(m)) += w * mp;
+      for (int d = 0; d < Dim; ++d) {
+        double internal = 0.0;
+        for (int e = 0; e < Dim; ++e) internal -= sigma(p, d, e) * s.gradient[k][e];
+        sums(lid, col.momentum(m, d)) += w * mp * v(p, d);
+        sums(lid, col.force(m, d)) += Vp * internal + w * mp * g[d];
+        // grad m(x_i) = sum_p m_p dS(x_i - x_p)/dx_i = -sum_p m_p dw_ip/dx_p
+        if (gradients) sums(lid, col.massGradient(m, d)) += -mp * s.gradient[k][d];
+      }
+    }
+  };
+  // One thread adds particle by particle; more threads go tile colour by tile colour, so that no
+  // two threads add into the same node (ParticleBins; no atomics, no per-thread copies).
+  const int threads = ExecutionSpace().concurrency();
+  if (threads > 1) {
+    bins_.build(particles_, grid, lookup, threads);
+    bins_current_ = true;
+    bins_.forEachParticle(scatter);
+  } else {
+    Kokkos::parallel_for("mpm::particles_to_grid", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count), scatter);
   }
   int missing_host = 0;
   Kokkos::deep_copy(missing_host, missing);
@@ -426,40 +426,45 @@ void MpmSolver<Dim>::gridToParticlesWith(double dt)
   // MUSL: the velocity update and the momentum it maps back, then the grid velocity u.
   if (remap) {
     node_velocity_new_->fill(0.0);
-    auto momentum = node_velocity_new_->view();
-    auto scatter = Kokkos::Experimental::create_scatter_view(momentum);  // as in particlesToGridWith
-    Kokkos::parallel_for(
-        "mpm::grid_to_particles_velocity", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count),
-        KOKKOS_LAMBDA(const int p) {
-          const int m = material(p);
-          if (table.rigid[m]) return;
-          double xp[Dim], lp[Dim];
-          for (int d = 0; d < Dim; ++d) xp[d] = x(p, d), lp[d] = half_width(p, d);
-          ShapeStencil<Dim, Kernel> s;
-          evaluateShape(xp, origin, spacing, lp, s);
-          LocalOrdinal lids[ShapeStencil<Dim, Kernel>::size];
-          double v_grid[Dim] = {}, dv[Dim] = {}, vp[Dim];
-          for (int k = 0; k < s.size; ++k) {
-            long long node[3] = {0, 0, 0};
-            s.node(k, node);
-            lids[k] = lookup(node[0], node[1], node[2]);
-            if (lids[k] < 0) continue;
-            const double w = s.weight[k];
-            for (int d = 0; d < Dim; ++d) {
-              const double vs = node_vs(lids[k], m * Dim + d);
-              v_grid[d] += w * vs;
-              dv[d] += w * (vs - node_v(lids[k], m * Dim + d));
-            }
-          }
-          for (int d = 0; d < Dim; ++d) vp[d] = v(p, d) = flip * (v(p, d) + dv[d]) + (1.0 - flip) * v_grid[d];
-          const double mp = mass(p);
-          auto sums = scatter.access();
-          for (int k = 0; k < s.size; ++k) {
-            if (lids[k] < 0) continue;
-            for (int d = 0; d < Dim; ++d) sums(lids[k], m * Dim + d) += s.weight[k] * mp * vp[d];
-          }
-        });
-    Kokkos::Experimental::contribute(momentum, scatter);
+    const auto momentum = node_velocity_new_->view();
+    const auto update = KOKKOS_LAMBDA(const int p)
+    {
+      const int m = material(p);
+      if (table.rigid[m]) return;
+      double xp[Dim], lp[Dim];
+      for (int d = 0; d < Dim; ++d) xp[d] = x(p, d), lp[d] = half_width(p, d);
+      ShapeStencil<Dim, Kernel> s;
+      evaluateShape(xp, origin, spacing, lp, s);
+      LocalOrdinal lids[ShapeStencil<Dim, Kernel>::size];
+      double v_grid[Dim] = {}, dv[Dim] = {}, vp[Dim];
+      for (int k = 0; k < s.size; ++k) {
+        long long node[3] = {0, 0, 0};
+        s.node(k, node);
+        lids[k] = lookup(node[0], node[1], node[2]);
+        if (lids[k] < 0) continue;
+        const double w = s.weight[k];
+        for (int d = 0; d < Dim; ++d) {
+          const double vs = node_vs(lids[k], m * Dim + d);
+          v_grid[d] += w * vs;
+          dv[d] += w * (vs - node_v(lids[k], m * Dim + d));
+        }
+      }
+      for (int d = 0; d < Dim; ++d) vp[d] = v(p, d) = flip * (v(p, d) + dv[d]) + (1.0 - flip) * v_grid[d];
+      const double mp = mass(p);
+      for (int k = 0; k < s.size; ++k) {
+        if (lids[k] < 0) continue;
+        for (int d = 0; d < Dim; ++d) momentum(lids[k], m * Dim + d) += s.weight[k] * mp * vp[d];
+      }
+    };
+    // The same scatter order as in particlesToGridWith: by tile colour on more than one thread.
+    if (ExecutionSpace().concurrency() > 1) {
+      if (!bins_current_) bins_.build(particles_, grid, lookup, ExecutionSpace().concurrency());
+      bins_current_ = true;
+      bins_.forEachParticle(update);
+    } else {
+      Kokkos::parallel_for("mpm::grid_to_particles_velocity", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count),
+                           update);
+    }
     node_velocity_new_->sumToOwners();
     const GridConditions<Dim> conditions =
         gridConditions<Dim>(*layout_, materials_, options_, empty_node_mass_, wall_no_slip_);
@@ -528,6 +533,7 @@ void MpmSolver<Dim>::gridToParticlesWith(double dt)
           for (int e = 0; e < Dim; ++e) F(p, d, e) = F_new(d, e);
         volume(p) = determinant(F_new) * initial_volume(p);
       });
+  bins_current_ = false;  // the particles moved
 }
 
 /// The constitutive update, last in the step (USL or MUSL), with the velocity gradient of G2P. Dispatch on
@@ -596,6 +602,7 @@ MigrationCounts MpmSolver<Dim>::relocateParticles()
 {
   const std::string error = pending_error_;
   pending_error_.clear();
+  bins_current_ = false;
   return (*migration_)(particles_, error);
 }
 

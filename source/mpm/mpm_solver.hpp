@@ -14,6 +14,7 @@
 // phases are public so that the coupled MPMICE step can call them between its fluid phases.
 #include "fields/field.hpp"
 #include "mpm/migration.hpp"
+#include "mpm/particle_bins.hpp"
 #include "mpm/particles.hpp"
 #include "mpm/solid_material.hpp"
 
@@ -163,6 +164,10 @@ class MpmSolver {
   std::unique_ptr<Field<Dim>> node_velocity_;       // v = p / m
   std::unique_ptr<Field<Dim>> node_velocity_star_;  // v* after forces, contact and walls
   std::unique_ptr<Field<Dim>> node_velocity_new_;   // MUSL: updated particle momenta mapped back
+  // With more than one thread, the particle-to-node scatters run tile colour by tile colour
+  // (ParticleBins); the bins of P2G hold until G2P moves the particles.
+  ParticleBins<Dim> bins_;
+  bool bins_current_ = false;
 };
 
 extern template class MpmSolver<2>;

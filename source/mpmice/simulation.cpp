@@ -20,6 +20,42 @@ namespace cfdmpm {
 
 namespace {
 
+/// Per material: mass, momentum components and kinetic energy summed over the owned cells, as one
+/// Kokkos reduction into an array (so that it runs on every thread of a threaded build).
+template <int Dim, class DensityView, class VelocityView>
+struct ConservedSums {
+  using value_type = double[];
+  using size_type = std::size_t;
+  size_type value_count;  // materials * (Dim + 2)
+  DensityView rho;
+  VelocityView u;
+  double volume;
+  int materials;
+
+  KOKKOS_INLINE_FUNCTION void operator()(const LocalOrdinal c, value_type sums) const
+  {
+    for (int m = 0; m < materials; ++m) {
+      const double mass = rho(c, m) * volume;
+      double speed2 = 0;
+      sums[m * (Dim + 2)] += mass;
+      for (int d = 0; d < Dim; ++d) {
+        const double ud = u(c, CellState<Dim>::velocityColumn(m, d));
+        sums[m * (Dim + 2) + 1 + d] += mass * ud;
+        speed2 += ud * ud;
+      }
+      sums[m * (Dim + 2) + 1 + Dim] += 0.5 * mass * speed2;
+    }
+  }
+  KOKKOS_INLINE_FUNCTION void init(value_type sums) const
+  {
+    for (size_type i = 0; i < value_count; ++i) sums[i] = 0.0;
+  }
+  KOKKOS_INLINE_FUNCTION void join(volatile value_type sums, const volatile value_type other) const
+  {
+    for (size_type i = 0; i < value_count; ++i) sums[i] += other[i];
+  }
+};
+
 /// Conserved quantities per material over the whole domain (per metre of depth in 2-D): mass (kg),
 /// momentum components (kg m/s) and kinetic energy (J), in the order of conservedColumns().
 template <int Dim>
@@ -27,21 +63,11 @@ std::vector<double> conservedQuantities(const CellState<Dim>& state)
 {
   const auto rho = state.density.view();
   const auto u = state.velocity.view();
-  const double volume = state.density.layout().grid().cellVolume();
-  const int per_material = Dim + 2;
-  std::vector<double> local(state.materials * per_material, 0.0), total(local.size(), 0.0);
-  for (LocalOrdinal c = 0; c < state.density.ownedCount(); ++c)
-    for (int m = 0; m < state.materials; ++m) {
-      const double mass = rho(c, m) * volume;
-      double speed2 = 0;
-      local[m * per_material] += mass;
-      for (int d = 0; d < Dim; ++d) {
-        const double ud = u(c, CellState<Dim>::velocityColumn(m, d));
-        local[m * per_material + 1 + d] += mass * ud;
-        speed2 += ud * ud;
-      }
-      local[m * per_material + 1 + Dim] += 0.5 * mass * speed2;
-    }
+  ConservedSums<Dim, decltype(rho), decltype(u)> sums{std::size_t(state.materials * (Dim + 2)), rho, u,
+                                                      state.density.layout().grid().cellVolume(), state.materials};
+  std::vector<double> local(sums.value_count, 0.0), total(local.size(), 0.0);
+  Kokkos::parallel_reduce("conserved quantities", Kokkos::RangePolicy<ExecutionSpace>(0, state.density.ownedCount()),
+                          sums, local.data());
   Teuchos::reduceAll(*state.density.layout().comm(), Teuchos::REDUCE_SUM, int(local.size()), local.data(),
                      total.data());
   return total;

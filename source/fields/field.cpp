@@ -1,5 +1,8 @@
 #include "fields/field.hpp"
 
+#include <stdexcept>
+#include <utility>
+
 namespace cfdmpm {
 
 template <int Dim>
@@ -53,6 +56,16 @@ void Field<Dim>::sumToOwners()
   if (selfOnly()) return;
   owned_->doExport(*overlap_, *importer(), Tpetra::ADD);
   exchangeHalo();
+}
+
+template <int Dim>
+void Field<Dim>::swapValues(Field& other)
+{
+  if (other.layout_ != layout_ || other.location_ != location_ || other.columns() != columns())
+    throw std::invalid_argument("Field::swapValues: '" + name_ + "' and '" + other.name_ +
+                                "' differ in layout, location or columns");
+  std::swap(overlap_, other.overlap_);
+  std::swap(owned_, other.owned_);
 }
 
 template <int Dim>

@@ -52,6 +52,11 @@ class Field {
   /// Moves the owned values to a new layout (new partition of the same grid) and refreshes ghosts.
   void repartition(std::shared_ptr<const Layout<Dim>> new_layout);
 
+  /// Exchanges the values (owned and ghost) with `other`, a field of the same layout, location and
+  /// column count, without copying: a kernel can write new values into a second field and then
+  /// make them this field's. Names stay with their fields.
+  void swapValues(Field& other);
+
  private:
   void allocate();
   const Teuchos::RCP<const Map>& ownedMap() const;

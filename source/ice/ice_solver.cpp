@@ -420,11 +420,9 @@ void IceSolver<Dim>::momentumAndExchange(CellState<Dim>& state, double dt)
           }
         });
   });
-  Kokkos::parallel_for(
-      "ice::copyVelocity", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
-      KOKKOS_LAMBDA(const LocalOrdinal c) {
-        for (int k = 0; k < n * Dim; ++k) u(c, k) = un(c, k);
-      });
+  // The new velocities become the state's; their ghosts are refreshed by the advection, the next
+  // reader. The old ones are work space from now on.
+  state.velocity.swapValues(new_velocity_);
 }
 
 // Energy (when not isothermal), per material with e = c_v T: the work of the pressure on the volume

@@ -269,6 +269,22 @@ void MpmSolver<Dim>::gridToParticles(double dt)
     gridToParticlesWith<LinearHat>(dt);
 }
 
+template <int Dim>
+template <class F>
+void MpmSolver<Dim>::forEachParticleScattering(const char* label, const BoxLookup& lookup, const F& f)
+{
+  // One thread adds particle by particle; more threads go tile colour by tile colour, so that no
+  // two threads add into the same node (ParticleBins; no atomics, no per-thread copies).
+  const int threads = ExecutionSpace().concurrency();
+  if (threads > 1) {
+    if (!bins_current_) bins_.build(particles_, layout_->grid(), lookup, threads);
+    bins_current_ = true;
+    bins_.forEachParticle(f);
+  } else {
+    Kokkos::parallel_for(label, Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count), f);
+  }
+}
+
 /// P2G: m_i = sum_p w_ip m_p, (mv)_i = sum_p w_ip m_p v_p,
 ///      f_i = sum_p (-V_p sigma_p grad w_ip + w_ip m_p g)   (internal + external force),
 ///      grad m_i = sum_p m_p grad w_ip                       (material normals for contact),
@@ -327,16 +343,9 @@ void MpmSolver<Dim>::particlesToGridWith()
       }
     }
   };
-  // One thread adds particle by particle; more threads go tile colour by tile colour, so that no
-  // two threads add into the same node (ParticleBins; no atomics, no per-thread copies).
-  const int threads = ExecutionSpace().concurrency();
-  if (threads > 1) {
-    bins_.build(particles_, grid, lookup, threads);
-    bins_current_ = true;
-    bins_.forEachParticle(scatter);
-  } else {
-    Kokkos::parallel_for("mpm::particles_to_grid", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count), scatter);
-  }
+  // P2G starts from particles that may have been moved or replaced since the last bins were built.
+  bins_current_ = false;
+  forEachParticleScattering("mpm::particles_to_grid", lookup, scatter);
   int missing_host = 0;
   Kokkos::deep_copy(missing_host, missing);
   if (missing_host > 0 && pending_error_.empty())  // raised on every rank by relocateParticles
@@ -456,15 +465,8 @@ void MpmSolver<Dim>::gridToParticlesWith(double dt)
         for (int d = 0; d < Dim; ++d) momentum(lids[k], m * Dim + d) += s.weight[k] * mp * vp[d];
       }
     };
-    // The same scatter order as in particlesToGridWith: by tile colour on more than one thread.
-    if (ExecutionSpace().concurrency() > 1) {
-      if (!bins_current_) bins_.build(particles_, grid, lookup, ExecutionSpace().concurrency());
-      bins_current_ = true;
-      bins_.forEachParticle(update);
-    } else {
-      Kokkos::parallel_for("mpm::grid_to_particles_velocity", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count),
-                           update);
-    }
+    // The same scatter order as in particlesToGridWith (its bins still hold: no particle moved).
+    forEachParticleScattering("mpm::grid_to_particles_velocity", lookup, update);
     node_velocity_new_->sumToOwners();
     const GridConditions<Dim> conditions =
         gridConditions<Dim>(*layout_, materials_, options_, empty_node_mass_, wall_no_slip_);

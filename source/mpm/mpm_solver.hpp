@@ -147,6 +147,11 @@ class MpmSolver {
   void particlesToGridWith();
   template <class Kernel>
   void gridToParticlesWith(double dt);
+  /// f(p) for every particle, for kernels that add into node arrays: in index order on one thread;
+  /// on more, tile colour by tile colour (bins_, rebuilt when stale), so no two threads add into
+  /// the same node.
+  template <class F>
+  void forEachParticleScattering(const char* label, const BoxLookup& lookup, const F& f);
   void allocateNodeFields();
 
   std::shared_ptr<const Layout<Dim>> layout_;

@@ -26,21 +26,21 @@ constexpr double kNegligibleMassShare = 1e-12;
 // velocity of its own (a denormal volume fraction would leave it uncoupled by the exchange).
 constexpr double kNegligibleVolumeShare = 1e-12;
 
-// Gives every material of cell c that holds a negligible share of its mass the mixture's
+// Gives every material of a cell that holds a negligible share of its mass the mixture's
 // (mass-weighted) velocity, so that its meaningless own value can neither limit the time step nor
-// leak into advection when it arrives. Returns the cell's mass density.
-template <int Dim, class DensityView, class VelocityView>
-KOKKOS_INLINE_FUNCTION double followMixtureVelocity(int n, LocalOrdinal c, const DensityView& rho,
-                                                    const VelocityView& u)
+// leak into advection when it arrives. rho(m): the material's mass density; u(m, d): its velocity
+// component, a reference. Returns the cell's mass density.
+template <int Dim, class Density, class Velocity>
+KOKKOS_INLINE_FUNCTION double followMixtureVelocity(int n, const Density& rho, const Velocity& u)
 {
   double mass = 0, momentum[3] = {0, 0, 0};
   for (int m = 0; m < n; ++m) {
-    mass += rho(c, m);
-    for (int d = 0; d < Dim; ++d) momentum[d] += rho(c, m) * u(c, m * Dim + d);
+    mass += rho(m);
+    for (int d = 0; d < Dim; ++d) momentum[d] += rho(m) * u(m, d);
   }
   for (int m = 0; m < n; ++m)
-    if (!(rho(c, m) > kNegligibleMassShare * mass))
-      for (int d = 0; d < Dim; ++d) u(c, m * Dim + d) = momentum[d] / (mass + kTiny);
+    if (!(rho(m) > kNegligibleMassShare * mass))
+      for (int d = 0; d < Dim; ++d) u(m, d) = momentum[d] / (mass + kTiny);
   return mass;
 }
 
@@ -406,18 +406,10 @@ void IceSolver<Dim>::momentumAndExchange(CellState<Dim>& state, double dt)
             v(c, m) = s[m];
           }
           ice::exchangeMomentumCC<Dim, N>(nm, dt, K, r, t, s, vel);
-          // A material with a negligible share of the mass takes the mixture's velocity (as
-          // followMixtureVelocity, on the cell's new values).
-          double mass = 0, momentum[3] = {0, 0, 0};
-          for (int m = 0; m < nm; ++m) {
-            mass += r[m];
-            for (int d = 0; d < Dim; ++d) momentum[d] += r[m] * vel[m][d];
-          }
-          for (int m = 0; m < nm; ++m) {
-            const bool negligible = !(r[m] > kNegligibleMassShare * mass);
-            for (int d = 0; d < Dim; ++d)
-              un(c, m * Dim + d) = negligible ? momentum[d] / (mass + kTiny) : vel[m][d];
-          }
+          followMixtureVelocity<Dim>(
+              nm, [&](int m) { return r[m]; }, [&](int m, int d) -> double& { return vel[m][d]; });
+          for (int m = 0; m < nm; ++m)
+            for (int d = 0; d < Dim; ++d) un(c, m * Dim + d) = vel[m][d];
         });
   });
   // The new velocities become the state's; their ghosts are refreshed by the advection, the next
@@ -604,7 +596,8 @@ IceStepReport IceSolver<Dim>::step(CellState<Dim>& state, double dt)
           KOKKOS_LAMBDA(const LocalOrdinal c) {
             const int nm = N > 0 ? N : n;
             for (int m = 0; m < nm; ++m) theta(c, m) = rho(c, m) * v(c, m);
-            const double mass = followMixtureVelocity<Dim>(nm, c, rho, u);
+            const double mass = followMixtureVelocity<Dim>(
+                nm, [&](int m) { return rho(c, m); }, [&](int m, int d) -> double& { return u(c, m * Dim + d); });
             double heat = 0, capacity = 0;
             for (int m = 0; m < nm; ++m) heat += rho(c, m) * cv[m] * T(c, m), capacity += rho(c, m) * cv[m];
             if (capacity > 0)

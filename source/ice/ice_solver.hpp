@@ -11,7 +11,7 @@
 //   [11] next Δt from convective CFL, viscosity and conduction
 //
 // The state is the shared CellState, so solid (MPM) materials can join the same equilibration,
-// pressure and exchange later. Isothermal by default (IceSettings::isothermal).
+// pressure and exchange later. Isothermal by default (the scene key `ice.isothermal`).
 #include "ice/advection.hpp"
 #include "ice/eos.hpp"
 #include "ice/face_field.hpp"
@@ -31,8 +31,8 @@ namespace cfdmpm {
 /// Settings of the ICE step, from the scene's `ice` section (doc/input.md).
 struct IceSettings {
   // The keys of `cfdmpm.ice`; their defaults and allowed values are in input/valid_parameters.cpp.
-  bool enabled = true;                   // false: fluids are an inert background (dry scenes)
-  bool isothermal = true;                // true: temperatures keep their values (no energy equation)
+  bool enabled = false;                  // false: fluids are an inert background (dry scenes)
+  bool isothermal = false;               // true: temperatures keep their values (no energy equation)
   double heat_exchange_coefficient = 0;  // H between every pair of materials (W/(m^3 K))
   std::string pressure;                  // "implicit" or "explicit" (for comparison)
   double exchange_coefficient = 0;       // momentum exchange K between every pair (kg/(m^3 s))

@@ -93,26 +93,20 @@ struct CellStencil {
 template <int Dim>
 struct Slabs {
   typename Field<Dim>::ConstView velocity[Dim];  // (cell, material): lower face of the cell
-  typename Layout<Dim>::IndexTable neighbours;
   double spacing[3] = {1, 1, 1};
   double dt = 0;
   bool transverse = true;
 
   Slabs(const FaceField<Dim>& face_velocity, const Layout<Dim>& layout, double time_step, bool transverse_correction)
-      : neighbours(layout.cellNeighbours()), dt(time_step), transverse(transverse_correction)
+      : dt(time_step), transverse(transverse_correction)
   {
     for (int d = 0; d < Dim; ++d) velocity[d] = face_velocity.direction(d).view();
     for (int d = 0; d < 3; ++d) spacing[d] = layout.grid().spacing()[d];
   }
 
-  /// Velocity through face f = 2 d + side of cell c, positive along +d. Domain faces are walls; a
-  /// face beyond the ghost layers is unknown and treated as closed (such cells are never donors
-  /// for an owned cell's faces).
-  KOKKOS_INLINE_FUNCTION double normalVelocity(int c, int f, int m) const
-  {
-    return normalVelocity(c, f, m, neighbours(c, f));
-  }
-  /// The same with the neighbour across f already read.
+  /// Velocity through face f = 2 d + side of cell c, positive along +d; n: the neighbour across f.
+  /// Domain faces are walls; a face beyond the ghost layers is unknown and treated as closed (such
+  /// cells are never donors for an owned cell's faces).
   KOKKOS_INLINE_FUNCTION double normalVelocity(int c, int f, int m, LocalOrdinal n) const
   {
     const int d = f / 2;

@@ -501,12 +501,11 @@ IceStepReport IceSolver<Dim>::step(CellState<Dim>& state, double dt)
       delta_p_.fill(0.0);
       // After this solve the right-hand side is the linear residual r plus the change of the
       // upwinded fluxes (the matrix uses mean face volume fractions). The outer test bounds
-      // max_c |rhs_c| / V and max_c |r_c| <= ||r||_2, so a residual of 2-norm below half of
-      // outer_tolerance V uses at most half of the outer test's allowance and leaves the other half
-      // to the flux change; solving further only polishes digits that the next right-hand side
-      // replaces (2.5-mm dam break: 12.3 instead of 13.6 CG iterations per step with a tenth, one
-      // outer iteration per step either way). An explicit solver_tolerance is honoured as given
-      // (e.g. tight solves to compare decompositions).
+      // max_c |rhs_c| / V, so a linear residual with max_c |r_c| below half of outer_tolerance V
+      // (the solver then tests the residual's largest entry) uses at most half of the outer test's
+      // allowance in every cell and leaves the other half to the flux change; solving further only
+      // polishes digits that the next right-hand side replaces (doc/ice-pressure.md). An explicit
+      // solver_tolerance is honoured as given (e.g. tight solves to compare decompositions).
       const double residual_target = settings_.solver_tolerance_given
                                          ? 0.0
                                          : 0.5 * settings_.outer_tolerance * layout_->grid().cellVolume();

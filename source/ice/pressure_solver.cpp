@@ -124,6 +124,15 @@ struct LowerFaceValues {
   KOKKOS_INLINE_FUNCTION Scalar operator()(int d, LocalOrdinal c) const { return direction[d](c, 0); }
 };
 
+/// ||v||₂ or max_i |v_i| (Belos::TwoNorm or Belos::InfNorm) over all ranks.
+double vectorNorm(const MultiVector& v, Belos::NormType norm)
+{
+  double value = 0;
+  if (norm == Belos::InfNorm) v.normInf(Teuchos::ArrayView<double>(&value, 1));
+  else v.norm2(Teuchos::ArrayView<double>(&value, 1));
+  return value;
+}
+
 void requireOneColumn(int columns, const std::string& name, const char* role)
 {
   if (columns != 1)
@@ -168,9 +177,9 @@ struct PressureSolver<Dim>::Impl {
   void buildGraph();
   Teuchos::ParameterList mueluParameters() const;
   Teuchos::RCP<Operator> preparePreconditioner(PressureSolveReport& report);
-  double residualNorm(const MultiVector& b, const MultiVector& x) const;
-  void runCG(const Teuchos::RCP<Operator>& preconditioner, const MultiVector& b, MultiVector& x, double b_norm,
-             double tolerance, PressureSolveReport& report) const;
+  double residualNorm(const MultiVector& b, const MultiVector& x, Belos::NormType norm) const;
+  void runCG(const Teuchos::RCP<Operator>& preconditioner, const MultiVector& b, MultiVector& x, Belos::NormType norm,
+             double b_norm, double tolerance, PressureSolveReport& report) const;
 };
 
 template <int Dim>
@@ -302,22 +311,21 @@ Teuchos::RCP<Operator> PressureSolver<Dim>::Impl::preparePreconditioner(Pressure
 }
 
 template <int Dim>
-double PressureSolver<Dim>::Impl::residualNorm(const MultiVector& b, const MultiVector& x) const
+double PressureSolver<Dim>::Impl::residualNorm(const MultiVector& b, const MultiVector& x, Belos::NormType norm) const
 {
   MultiVector& r = *residual;
   r.assign(b);
   matrix->apply(x, r, Teuchos::NO_TRANS, -1.0, 1.0);  // r = b - A x
-  double norm = 0;
-  r.norm2(Teuchos::ArrayView<double>(&norm, 1));
-  return norm;
+  return vectorNorm(r, norm);
 }
 
-/// Belos CG on A x = b from the current x, adding to the report. Belos's stopping test uses the
-/// recurrence residual, which can drift from the true one; if they disagree we restart from the
-/// current iterate (a restart recomputes the residual), at most twice, within the iteration budget.
+/// Belos CG on A x = b from the current x, adding to the report: it stops when ||b − A x|| <=
+/// tolerance ||b|| in the given norm (b_norm = ||b||). Belos's stopping test uses the recurrence
+/// residual, which can drift from the true one; if they disagree we restart from the current iterate
+/// (a restart recomputes the residual), at most twice, within the iteration budget.
 template <int Dim>
 void PressureSolver<Dim>::Impl::runCG(const Teuchos::RCP<Operator>& preconditioner, const MultiVector& b,
-                                      MultiVector& x, double b_norm, double tolerance,
+                                      MultiVector& x, Belos::NormType norm, double b_norm, double tolerance,
                                       PressureSolveReport& report) const
 {
   auto problem = Teuchos::rcp(new Belos::LinearProblem<Scalar, MultiVector, Operator>(
@@ -331,14 +339,18 @@ void PressureSolver<Dim>::Impl::runCG(const Teuchos::RCP<Operator>& precondition
   int iterations = 0;
   for (int attempt = 0; attempt < 3; ++attempt) {
     auto belos = Teuchos::rcp(new Teuchos::ParameterList);
-    belos->set("Convergence Tolerance", tolerance);
+    // Belos scales the residual by ||b|| only in the 2-norm, so the test is given as the absolute
+    // bound tolerance ||b|| (unscaled), in the norm set on the status test below.
+    belos->set("Convergence Tolerance", tolerance * b_norm);
     belos->set("Maximum Iterations", settings.maximum_iterations - iterations);
-    belos->set("Implicit Residual Scaling", std::string("Norm of RHS"));  // relative to ||b||, not ||r0||
+    belos->set("Implicit Residual Scaling", std::string("None"));
     belos->set("Verbosity", verbosity);
     belos->set("Output Style", int(Belos::Brief));
     belos->set("Output Frequency", settings.verbosity >= 2 ? 1 : -1);
     problem->setProblem();  // residual of the current iterate
     Belos::PseudoBlockCGSolMgr<Scalar, MultiVector, Operator> cg(problem, belos);
+    cg.getResidualStatusTest()->defineResForm(Belos::StatusTestGenResNorm<Scalar, MultiVector, Operator>::Implicit,
+                                              norm);
     Belos::ReturnType result = Belos::Unconverged;
     try {
       result = cg.solve();
@@ -346,7 +358,7 @@ void PressureSolver<Dim>::Impl::runCG(const Teuchos::RCP<Operator>& precondition
       report.failure = e.what();
     }
     iterations += cg.getNumIters();
-    report.relative_residual = residualNorm(b, x) / b_norm;
+    report.relative_residual = residualNorm(b, x, norm) / b_norm;
     report.converged = report.relative_residual <= tolerance;
     if (report.converged || result != Belos::Converged || iterations >= settings.maximum_iterations) break;
   }
@@ -508,8 +520,10 @@ PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>
 
   const MultiVector& b = rhs.owned();
   MultiVector& x = solution.owned();
-  double b_norm = 0;
-  b.norm2(Teuchos::ArrayView<double>(&b_norm, 1));
+  // The norm of the stopping test: the 2-norm, or with an absolute target the largest entry (the
+  // caller bounds every cell's residual, and the 2-norm can exceed it by up to sqrt(cells)).
+  const Belos::NormType norm = residual_target > 0 ? Belos::InfNorm : Belos::TwoNorm;
+  const double b_norm = vectorNorm(b, norm);
   if (b_norm == 0) {  // A is SPD, so the answer is exactly zero
     x.putScalar(0);
     solution.exchangeHalo();
@@ -539,7 +553,7 @@ PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>
   start = Clock::now();
   {
     Teuchos::TimeMonitor timer(*m.cg_timer);
-    m.runCG(preconditioner, b, x, b_norm, report.tolerance, report);
+    m.runCG(preconditioner, b, x, norm, b_norm, report.tolerance, report);
   }
   report.solve_seconds = secondsSince(start);
 
@@ -559,7 +573,7 @@ PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>
     report.failure.clear();
     {
       Teuchos::TimeMonitor timer(*m.cg_timer);
-      m.runCG(preconditioner, b, x, b_norm, report.tolerance, report);
+      m.runCG(preconditioner, b, x, norm, b_norm, report.tolerance, report);
     }
     report.solve_seconds += secondsSince(start);
   }

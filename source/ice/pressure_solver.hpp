@@ -27,7 +27,8 @@
 namespace cfdmpm {
 
 /// What one pressure solve did. `converged` is true only when the true relative residual
-/// ||b − A x|| / ||b||, computed after the solve, is at most the tolerance; the caller decides what
+/// ||b − A x|| / ||b|| (in the norm of the solve, see solve()), computed after the solve, is at most
+/// the tolerance; the caller decides what
 /// to do with an unconverged answer (Uintah restarts the time step with a smaller Δt).
 struct PressureSolveReport {
   int iterations = 0;                   // CG iterations, summed over restarts and a fallback setup
@@ -78,9 +79,10 @@ class PressureSolver {
 
   /// Solves A δp = rhs. `solution` holds the initial guess on entry (warm start) and the answer on
   /// return, with its ghost entries exchanged. Both fields have 1 column; owned rows of rhs are read.
-  /// CG stops when the true residual ||rhs − A δp||₂ is at most max(tolerance ||rhs||₂,
-  /// residual_target) (and at most 0.5 ||rhs||₂): a caller whose own convergence test needs no more
-  /// than an absolute residual (the ICE outer iteration) passes it as residual_target.
+  /// CG stops when the true residual ||rhs − A δp||₂ is at most tolerance ||rhs||₂. A caller whose
+  /// own convergence test needs no more than an absolute bound on every cell's residual (the ICE
+  /// outer iteration) passes it as residual_target > 0: then the residual's largest entry is tested,
+  /// max_c |rhs − A δp|_c <= max(tolerance max_c |rhs_c|, residual_target) (and <= 0.5 max_c |rhs_c|).
   /// Never throws for an unconverged solve: see the report. When a solve with a reused MueLu
   /// hierarchy fails, a fresh hierarchy is built and the solve repeated from the initial guess.
   PressureSolveReport solve(const Field<Dim>& rhs, Field<Dim>& solution, double residual_target = 0);

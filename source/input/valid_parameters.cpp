@@ -207,8 +207,9 @@ void defineIce(ParameterList& ice)
          "mismatch of a cell in one step, as a fraction of its volume (doc/ice.md).",
          positive(""));
   define(ice, "solver_tolerance", 0.0,
-         "Relative residual of each linear pressure solve. 0: each solve stops once its residual's 2-norm is "
-         "below 0.5 `outer_tolerance` V (doc/ice-pressure.md), or at 1e-10 relative if that comes first.",
+         "Relative residual (2-norm) of each linear pressure solve. 0: each solve stops once every cell's "
+         "residual is below 0.5 `outer_tolerance` V (doc/ice-pressure.md), or at 1e-10 of the largest entry of "
+         "the right-hand side if that comes first.",
          between(0, false, 1e-2, true));
   define(ice, "dt_growth", 1.2, "Largest ratio of successive time steps.", greaterThan(1));
   defineSection(ice, "linear_solver",

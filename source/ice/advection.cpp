@@ -1,11 +1,12 @@
-// Advection kernels. One step, per material (doc/ice-advection.md), three passes over the cells:
-//   1. the outflow check: Σ_faces V_out <= V_cell everywhere, or the step is refused (one
-//      reduction, which also finds the cell of the maximum);
-//   2. the slabs, owned cells and the first ghost layer (so that every owned face has its donor):
+// Advection kernels. One step, per material (doc/ice-advection.md), two passes over the cells:
+//   1. the slabs, owned cells and the first ghost layer (so that every owned face has its donor):
 //      each cell's limited linear mass profile gives the mass leaving through each face, then the
 //      slab values of every mass-specific column of every field (the slab geometry and the
-//      remaining mass are computed once per cell and material);
-//   3. one pass over the owned cells writes the new mass and the new q of every column in place
+//      remaining mass are computed once per cell and material). The same pass is the outflow
+//      check: Σ_faces V_out <= V_cell in every owned cell, or the step is refused (a reduction,
+//      which also finds the cell of the maximum); it writes only work arrays, so a refused step
+//      leaves the fields as they were;
+//   2. one pass over the owned cells writes the new mass and the new q of every column in place
 //      (it reads other cells only through the slab arrays); ghosts of the outputs refreshed.
 #include "ice/advection.hpp"
 
@@ -150,31 +151,16 @@ struct Slabs {
   }
 };
 
-/// The largest outflow fraction Σ_faces V_out / V_cell over cells and materials, and among the
-/// entries that attain it the lowest key = global cell id · materials + material (so that every
-/// decomposition names the same cell): one reduction over the cells.
-struct LargestOutflow {
-  double value;
-  long long key;
-};
-
-template <int Dim>
-struct LargestOutflowReduction {
+/// Kokkos reducer of LargestOutflow (the slab kernel is a parallel_reduce with it).
+struct LargestOutflowReducer {
+  using reducer = LargestOutflowReducer;
   using value_type = LargestOutflow;
-  Slabs<Dim> slabs;
-  CellStencil<Dim> stencil;
-  int materials;
+  using result_view_type = Kokkos::View<value_type, Kokkos::HostSpace, Kokkos::MemoryUnmanaged>;
 
-  KOKKOS_INLINE_FUNCTION void operator()(const int c, value_type& best) const
+  explicit LargestOutflowReducer(value_type& result) : result_(&result) {}
+  KOKKOS_INLINE_FUNCTION void join(value_type& best, const value_type& other) const
   {
-    LocalOrdinal neighbour[2 * Dim];
-    for (int f = 0; f < 2 * Dim; ++f) neighbour[f] = stencil.neighbours(c, f);
-    for (int m = 0; m < materials; ++m) {
-      const double value = slabs.totalOutflowFraction(c, m, neighbour);
-      if (!(value >= best.value)) continue;  // also skips a NaN
-      const long long key = stencil.globalId(c) * materials + m;
-      if (value > best.value || key < best.key) best.value = value, best.key = key;
-    }
+    best.include(other.value, other.key);
   }
   KOKKOS_INLINE_FUNCTION void join(volatile value_type& best, const volatile value_type& other) const
   {
@@ -186,6 +172,12 @@ struct LargestOutflowReduction {
     best.value = -DBL_MAX;
     best.key = LLONG_MAX;
   }
+  KOKKOS_INLINE_FUNCTION value_type& reference() const { return *result_; }
+  result_view_type view() const { return result_view_type(result_); }
+  KOKKOS_INLINE_FUNCTION bool references_scalar() const { return true; }
+
+ private:
+  value_type* result_;
 };
 
 /// The limiter factor in [0, 1] for a linear profile value + φ g·r in one cell.
@@ -250,19 +242,14 @@ Advector<Dim>::Advector(std::shared_ptr<const Layout<Dim>> layout, int materials
   outflow_mass_ = WorkView("advection outflow mass", cells, 2 * Dim, materials);
 }
 
+/// The status of a step whose slab pass found `local` on this rank: the maximum over all ranks, and
+/// the lowest global key that attains it, so every rank count reports the same cell.
 template <int Dim>
-AdvectionStatus Advector<Dim>::checkOutflux(const FaceField<Dim>& face_velocity, double dt) const
+AdvectionStatus Advector<Dim>::outfluxStatus(const LargestOutflow& local) const
 {
-  const LargestOutflowReduction<Dim> reduction{Slabs<Dim>(face_velocity, *layout_, dt, options_.transverse_correction),
-                                               CellStencil<Dim>(*layout_, block_), materials_};
-  LargestOutflow local;
-  Kokkos::parallel_reduce("advection outflux max", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
-                          reduction, local);
   AdvectionStatus status;
   const auto& comm = *layout_->comm();
   Teuchos::reduceAll(comm, Teuchos::REDUCE_MAX, local.value, Teuchos::outArg(status.max_outflux_fraction));
-
-  // The cell that attains the maximum, lowest global id first, so every rank count reports the same.
   const long long local_first = local.value == status.max_outflux_fraction ? local.key : LLONG_MAX;
   long long first = LLONG_MAX;
   Teuchos::reduceAll(comm, Teuchos::REDUCE_MIN, local_first, Teuchos::outArg(first));
@@ -292,16 +279,15 @@ AdvectionStatus Advector<Dim>::advect(FaceField<Dim>& face_velocity, double dt, 
   // 1. Ghosts of every input are current: fluxes on an owned cell's faces may come from a ghost
   //    donor, whose reconstruction reads the ghosts beyond it.
   face_velocity.exchangeHalo();
-  const AdvectionStatus status = checkOutflux(face_velocity, dt);
-  if (!status.ok) return status;
   mass.exchangeHalo();
   for (Field<Dim>* q : mass_specific) q->exchangeHalo();
 
-  // 2. + 3. Mass leaving each cell through each face, from the limited density profile of the
-  //    donor, and the slab values of every mass-specific column, in one pass.
-  reconstruct(face_velocity, dt, mass, mass_specific);
+  // 2. Mass leaving each cell through each face, from the limited density profile of the donor,
+  //    and the slab values of every mass-specific column, in one pass that also checks the outflow.
+  const AdvectionStatus status = outfluxStatus(reconstruct(face_velocity, dt, mass, mass_specific));
+  if (!status.ok) return status;
 
-  // 4. New mass and compatible update of every column, then the outputs' ghosts.
+  // 3. New mass and compatible update of every column, then the outputs' ghosts.
   update(mass, mass_specific);
   mass.exchangeHalo();
   for (Field<Dim>* q : mass_specific) q->exchangeHalo();
@@ -339,8 +325,8 @@ QuantityColumns<Dim, View, kMaxFields> quantityColumns(const std::vector<FieldPo
 }  // namespace
 
 template <int Dim>
-void Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass,
-                                const std::vector<Field<Dim>*>& mass_specific)
+LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass,
+                                          const std::vector<Field<Dim>*>& mass_specific)
 {
   const Slabs<Dim> slabs(face_velocity, *layout_, dt, options_.transverse_correction);
   const CellStencil<Dim> stencil(*layout_, block_);
@@ -357,6 +343,7 @@ void Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, double dt, 
   const auto outflow_value = outflow_value_;
   const auto bounds = bounds_;
   const int materials = materials_;
+  const LocalOrdinal owned = layout_->ownedCells();
 
   // Per cell (owned and ghost, so that every owned face has its donor) and material, the slab
   // geometry from the cell's 2 Dim face velocities, then:
@@ -367,12 +354,16 @@ void Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, double dt, 
   // - the same for every column q, whose slabs weigh their mass F_f: the limited profile keeps q
   //   within its block bounds in the slabs and in the mass left behind, so the new q is a
   //   mass-weighted mean of values within bounds (compatible fluxes).
-  // Both read the old mass and the cell's own slabs only.
-  Kokkos::parallel_for(
-      "advection slabs", Kokkos::RangePolicy<ExecutionSpace>(0, cells), KOKKOS_LAMBDA(int c) {
+  // Both read the old mass and the cell's own slabs only. Owned cells also enter the largest
+  // outflow fraction Σ_f V_out / V_cell of every material, with or without mass.
+  LargestOutflow largest;
+  Kokkos::parallel_reduce(
+      "advection slabs", Kokkos::RangePolicy<ExecutionSpace>(0, cells),
+      KOKKOS_LAMBDA(int c, LargestOutflow& best) {
         const auto local = stencil.local(c);
         for (int m = 0; m < materials; ++m) {
           if (M(c, m) == 0.0) {
+            if (c < owned) best.include(slabs.totalOutflowFraction(c, m, local.neighbour), stencil.globalId(c) * materials + m);
             // No mass of m here: nothing leaves (masses are >= 0, so the block's lower bound is 0
             // and the limiter sets the slope to 0: every slab would carry exactly 0). The slab
             // values then weigh nothing; only the block bounds of q are needed, to bound q where
@@ -393,6 +384,11 @@ void Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, double dt, 
           }
           double fraction[2 * Dim], r[2 * Dim][Dim];
           slabs.cellSlabs(c, m, local.neighbour, fraction, r);
+          if (c < owned) {
+            double total = 0;
+            for (int f = 0; f < 2 * Dim; ++f) total += fraction[f];
+            best.include(total, stencil.globalId(c) * materials + m);
+          }
           double g[Dim], spread = 0;
           for (int d = 0; d < Dim; ++d) {
             g[d] = stencil.gradient(M, c, local, m, d);
@@ -445,7 +441,9 @@ void Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, double dt, 
             }
           }
         }
-      });
+      },
+      LargestOutflowReducer(largest));
+  return largest;
 }
 
 template <int Dim>

@@ -21,6 +21,20 @@
 
 namespace cfdmpm {
 
+/// The largest outflow fraction Σ_faces V_out / V_cell over cells and materials, and among the
+/// entries that attain it the lowest key = global cell id · materials + material (so that every
+/// decomposition names the same cell).
+struct LargestOutflow {
+  double value;
+  long long key;
+
+  KOKKOS_INLINE_FUNCTION void include(double candidate, long long candidate_key)
+  {
+    if (!(candidate >= value)) return;  // also skips a NaN
+    if (candidate > value || candidate_key < key) value = candidate, key = candidate_key;
+  }
+};
+
 /// Result of one advection step. The step is refused (fields unchanged) when some cell would send
 /// out more than its volume in one step (Uintah's "bulletproofing"): the caller reduces Δt.
 struct AdvectionStatus {
@@ -62,10 +76,6 @@ class Advector {
   AdvectionStatus advect(FaceField<Dim>& face_velocity, double dt, Field<Dim>& mass,
                          const std::vector<Field<Dim>*>& mass_specific);
 
-  /// The outflow Courant check alone (max over cells and materials of Σ V_out / V_cell), without
-  /// refreshing the face velocity's ghosts.
-  AdvectionStatus checkOutflux(const FaceField<Dim>& face_velocity, double dt) const;
-
   int materials() const { return materials_; }
 
   using WorkView = Kokkos::View<double***, MemorySpace>;  // (local cell, face, material)
@@ -74,8 +84,10 @@ class Advector {
   static constexpr int kMaxFields = 8;
 
  private:
-  void reconstruct(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass,
-                   const std::vector<Field<Dim>*>& mass_specific);
+  /// The slab pass; returns this rank's largest outflow fraction and where it occurs.
+  LargestOutflow reconstruct(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass,
+                             const std::vector<Field<Dim>*>& mass_specific);
+  AdvectionStatus outfluxStatus(const LargestOutflow& local) const;
   void update(Field<Dim>& mass, const std::vector<Field<Dim>*>& mass_specific);
 
   std::shared_ptr<const Layout<Dim>> layout_;

@@ -30,6 +30,11 @@ class FaceField {
   {
     for (auto& f : directions_) f.fill(value);
   }
+  /// Exchanges the values of every direction with `other` (Field::swapValues), without copying.
+  void swapValues(FaceField& other)
+  {
+    for (int d = 0; d < Dim; ++d) directions_[d].swapValues(other.directions_[d]);
+  }
 
  private:
   std::vector<Field<Dim>> directions_;

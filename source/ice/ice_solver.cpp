@@ -102,6 +102,7 @@ IceSolver<Dim>::IceSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>>
       sum_delta_p_(layout, Location::Cell, 1, "sum_delta_p"),
       rhs_(layout, Location::Cell, 1, "pressure_rhs"),
       face_velocity_(layout, materials_, "face_velocity"),
+      corrected_face_velocity_(layout, materials_, "corrected_face_velocity"),
       face_specific_volume_(layout, materials_, "face_specific_volume"),
       face_beta_(layout, 1, "face_beta"),
       new_velocity_(layout, Location::Cell, materials_ * Dim, "new_velocity"),
@@ -257,34 +258,55 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
 
 // [5] Right-hand side of the pressure equation, −Δt Σ_faces A Σ_m θ_upwind,m u_f,m · n_out
 // − V κ Σδp (the outer-iteration residual form of Uintah's setupRHS); returns max |rhs| / V.
+// after_solve: first apply the solve's δp, in the same pass: Σδp += δp, p = p_eq + Σδp, and every
+// face velocity u_f −= Δt v_f (δp_R − δp_L) / h (owned cells; the ghosts of p and Σδp are not read
+// before the momentum phase refreshes p). Each cell corrects its lower faces into a second array and
+// recomputes its upper faces from the old values (they belong to the upper neighbour, whose
+// iteration may run at the same time); the arrays then swap and the ghosts are refreshed.
 template <int Dim>
-double IceSolver<Dim>::pressureRightHandSide(const CellState<Dim>& state, double dt)
+double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, bool after_solve)
 {
   const int n = materials_;
   const auto neighbours = layout_->cellNeighbours();
   const auto theta = state.volume_fraction.view();
   const auto sum_kappa = mixture_compressibility_.view();
-  const auto sum_dp = sum_delta_p_.view();
+  auto sum_dp = sum_delta_p_.view();
+  const auto dp = delta_p_.view();
+  auto p = state.pressure.view();
+  const auto p_eq = equilibrium_pressure_.view();
   auto rhs = rhs_.view();
   const double volume = layout_->grid().cellVolume();
-  double area[3];
-  for (int d = 0; d < Dim; ++d) area[d] = volume / layout_->grid().spacing()[d];
-  typename Field<Dim>::ConstView uf[3];
-  for (int d = 0; d < Dim; ++d) uf[d] = face_velocity_.direction(d).view();
+  double area[3], h[3];
+  for (int d = 0; d < Dim; ++d) h[d] = layout_->grid().spacing()[d], area[d] = volume / h[d];
+  typename Field<Dim>::ConstView uf[3], vf[3];
+  typename Field<Dim>::View corrected[3];
+  for (int d = 0; d < Dim; ++d) {
+    uf[d] = face_velocity_.direction(d).view();
+    vf[d] = face_specific_volume_.direction(d).view();
+    corrected[d] = corrected_face_velocity_.direction(d).view();
+  }
   double local_max = 0;
   Kokkos::parallel_reduce(
       "ice::pressureRhs", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
       KOKKOS_LAMBDA(const LocalOrdinal c, double& worst) {
+        if (after_solve) {
+          sum_dp(c, 0) += dp(c, 0);
+          p(c, 0) = p_eq(c, 0) + sum_dp(c, 0);
+        }
         double outflow = 0;  // Σ_faces A Σ_m θ_upwind u · n_out  (m^3/s)
         for (int d = 0; d < Dim; ++d) {
           const LocalOrdinal l = neighbours(c, 2 * d), r = neighbours(c, 2 * d + 1);
           for (int m = 0; m < n; ++m) {
             if (l >= 0) {  // lower face, outward normal −e_d
-              const double w = uf[d](c, m);
+              double w = uf[d](c, m);
+              if (after_solve) corrected[d](c, m) = w = w - dt * vf[d](c, m) * (dp(c, 0) - dp(l, 0)) / h[d];
               outflow -= area[d] * w * (w > 0 ? theta(l, m) : theta(c, m));
+            } else if (after_solve) {
+              corrected[d](c, m) = uf[d](c, m);  // a wall: stays zero
             }
             if (r >= 0) {  // upper face, stored on the upper neighbour
-              const double w = uf[d](r, m);
+              double w = uf[d](r, m);
+              if (after_solve) w = w - dt * vf[d](r, m) * (dp(r, 0) - dp(c, 0)) / h[d];
               outflow += area[d] * w * (w > 0 ? theta(c, m) : theta(r, m));
             }
           }
@@ -294,31 +316,13 @@ double IceSolver<Dim>::pressureRightHandSide(const CellState<Dim>& state, double
         if (a > worst) worst = a;
       },
       Kokkos::Max<double>(local_max));
+  if (after_solve) {
+    face_velocity_.swapValues(corrected_face_velocity_);
+    face_velocity_.exchangeHalo();
+  }
   double global_max = 0;
   Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_MAX, local_max, Teuchos::outArg(global_max));
   return global_max;
-}
-
-// [5] u_f −= Δt v_f (δp_R − δp_L) / h for every material.
-template <int Dim>
-void IceSolver<Dim>::correctFaceVelocities(double dt)
-{
-  const int n = materials_;
-  const auto neighbours = layout_->cellNeighbours();
-  const auto dp = delta_p_.view();
-  for (int d = 0; d < Dim; ++d) {
-    auto uf = face_velocity_.direction(d).view();
-    const auto vf = face_specific_volume_.direction(d).view();
-    const double h = layout_->grid().spacing()[d];
-    Kokkos::parallel_for(
-        "ice::correctFaceVelocities", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
-        KOKKOS_LAMBDA(const LocalOrdinal c) {
-          const LocalOrdinal l = neighbours(c, 2 * d);
-          if (l < 0) return;
-          for (int m = 0; m < n; ++m) uf(c, m) -= dt * vf(c, m) * (dp(c, 0) - dp(l, 0)) / h;
-        });
-  }
-  face_velocity_.exchangeHalo();
 }
 
 // [6] + [8] Momentum sources and Lagrangian values, then the implicit cell-centred momentum exchange
@@ -491,10 +495,9 @@ IceStepReport IceSolver<Dim>::step(CellState<Dim>& state, double dt)
   // [5] Pressure correction with outer iterations (implicit), or one explicit update.
   std::optional<Teuchos::TimeMonitor> pressure_phase(std::in_place, *timers_.at("pressure"));
   sum_delta_p_.fill(0.0);
-  delta_p_.fill(0.0);
   const bool implicit = settings_.pressure == "implicit";
   if (implicit) pressure_solver_->assemble(mixture_compressibility_, face_beta_, dt);
-  double residual = pressureRightHandSide(state, dt);
+  double residual = pressureRightHandSide(state, dt, false);
   while (residual > settings_.outer_tolerance && report.outer_iterations < settings_.max_outer_iterations) {
     ++report.outer_iterations;
     if (implicit) {
@@ -522,36 +525,27 @@ IceStepReport IceSolver<Dim>::step(CellState<Dim>& state, double dt)
         throw std::runtime_error(message.str());
       }
     } else {
-      // Explicit: δp = rhs / (V κ), faces not coupled through the pressure Laplacian.
+      // Explicit: δp = rhs / (V κ) (faces not coupled through the pressure Laplacian) and
+      // p = p_eq + δp in one pass; no face correction, no further iteration.
       const auto rhs = rhs_.view();
       const auto sk = mixture_compressibility_.view();
       auto dp = delta_p_.view();
+      auto sum = sum_delta_p_.view();
+      auto p = state.pressure.view();
+      const auto p_eq = equilibrium_pressure_.view();
       const double volume = layout_->grid().cellVolume();
       Kokkos::parallel_for(
           "ice::explicitPressure", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
-          KOKKOS_LAMBDA(const LocalOrdinal c) { dp(c, 0) = rhs(c, 0) / (volume * sk(c, 0)); });
-      delta_p_.exchangeHalo();
-    }
-    // p = p_eq + Σδp; faces corrected with this iteration's δp.
-    {
-      auto sum = sum_delta_p_.view();
-      const auto dp = delta_p_.view();
-      auto p = state.pressure.view();
-      const auto p_eq = equilibrium_pressure_.view();
-      Kokkos::parallel_for(
-          "ice::updatePressure", Kokkos::RangePolicy<ExecutionSpace>(0, delta_p_.overlapCount()),
           KOKKOS_LAMBDA(const LocalOrdinal c) {
+            dp(c, 0) = rhs(c, 0) / (volume * sk(c, 0));
             sum(c, 0) += dp(c, 0);
             p(c, 0) = p_eq(c, 0) + sum(c, 0);
           });
-    }
-    if (!implicit) {
-      // The explicit scheme does not correct face velocities: one pass.
       residual = 0;
       break;
     }
-    correctFaceVelocities(dt);
-    residual = pressureRightHandSide(state, dt);
+    // p = p_eq + Σδp and the faces corrected with this iteration's δp, then the new residual.
+    residual = pressureRightHandSide(state, dt, true);
   }
   report.outer_residual = residual;
   report.converged = residual <= settings_.outer_tolerance || !implicit;

@@ -90,8 +90,7 @@ class IceSolver {
 
  private:
   void faceVelocities(const CellState<Dim>& state, double dt);
-  double pressureRightHandSide(const CellState<Dim>& state, double dt);
-  void correctFaceVelocities(double dt);
+  double pressureRightHandSide(CellState<Dim>& state, double dt, bool after_solve);
   void momentumAndExchange(CellState<Dim>& state, double dt);
   void energy(CellState<Dim>& state, const Field<Dim>& old_specific_volume, double dt);
 
@@ -113,6 +112,7 @@ class IceSolver {
   Field<Dim> equilibrium_pressure_;
   Field<Dim> delta_p_, sum_delta_p_, rhs_;
   FaceField<Dim> face_velocity_;        // per material
+  FaceField<Dim> corrected_face_velocity_;  // work array of the pressure correction
   FaceField<Dim> face_specific_volume_; // per material, after the face exchange
   FaceField<Dim> face_beta_;            // Σ θ_f v_f
   Field<Dim> new_velocity_;             // work array of the momentum update

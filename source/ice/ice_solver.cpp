@@ -286,36 +286,45 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
     corrected[d] = corrected_face_velocity_.direction(d).view();
   }
   double local_max = 0;
-  Kokkos::parallel_reduce(
-      "ice::pressureRhs", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
-      KOKKOS_LAMBDA(const LocalOrdinal c, double& worst) {
-        if (after_solve) {
-          sum_dp(c, 0) += dp(c, 0);
-          p(c, 0) = p_eq(c, 0) + sum_dp(c, 0);
-        }
-        double outflow = 0;  // Σ_faces A Σ_m θ_upwind u · n_out  (m^3/s)
-        for (int d = 0; d < Dim; ++d) {
-          const LocalOrdinal l = neighbours(c, 2 * d), r = neighbours(c, 2 * d + 1);
-          for (int m = 0; m < n; ++m) {
-            if (l >= 0) {  // lower face, outward normal −e_d
-              double w = uf[d](c, m);
-              if (after_solve) corrected[d](c, m) = w = w - dt * vf[d](c, m) * (dp(c, 0) - dp(l, 0)) / h[d];
-              outflow -= area[d] * w * (w > 0 ? theta(l, m) : theta(c, m));
-            } else if (after_solve) {
-              corrected[d](c, m) = uf[d](c, m);  // a wall: stays zero
-            }
-            if (r >= 0) {  // upper face, stored on the upper neighbour
-              double w = uf[d](r, m);
-              if (after_solve) w = w - dt * vf[d](r, m) * (dp(r, 0) - dp(c, 0)) / h[d];
-              outflow += area[d] * w * (w > 0 ? theta(c, m) : theta(r, m));
+  const auto kernel = [&](auto count, auto correct) {
+    constexpr int N = decltype(count)::value;
+    constexpr bool kCorrect = decltype(correct)::value;
+    Kokkos::parallel_reduce(
+        "ice::pressureRhs", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+        KOKKOS_LAMBDA(const LocalOrdinal c, double& worst) {
+          const int nm = N > 0 ? N : n;
+          if (kCorrect) {
+            sum_dp(c, 0) += dp(c, 0);
+            p(c, 0) = p_eq(c, 0) + sum_dp(c, 0);
+          }
+          double outflow = 0;  // Σ_faces A Σ_m θ_upwind u · n_out  (m^3/s)
+          for (int d = 0; d < Dim; ++d) {
+            const LocalOrdinal l = neighbours(c, 2 * d), r = neighbours(c, 2 * d + 1);
+            for (int m = 0; m < nm; ++m) {
+              if (l >= 0) {  // lower face, outward normal −e_d
+                double w = uf[d](c, m);
+                if (kCorrect) corrected[d](c, m) = w = w - dt * vf[d](c, m) * (dp(c, 0) - dp(l, 0)) / h[d];
+                outflow -= area[d] * w * (w > 0 ? theta(l, m) : theta(c, m));
+              } else if (kCorrect) {
+                corrected[d](c, m) = uf[d](c, m);  // a wall: stays zero
+              }
+              if (r >= 0) {  // upper face, stored on the upper neighbour
+                double w = uf[d](r, m);
+                if (kCorrect) w = w - dt * vf[d](r, m) * (dp(r, 0) - dp(c, 0)) / h[d];
+                outflow += area[d] * w * (w > 0 ? theta(c, m) : theta(r, m));
+              }
             }
           }
-        }
-        rhs(c, 0) = -dt * outflow - volume * sum_kappa(c, 0) * sum_dp(c, 0);
-        const double a = Kokkos::Experimental::fabs(rhs(c, 0)) / volume;
-        if (a > worst) worst = a;
-      },
-      Kokkos::Max<double>(local_max));
+          rhs(c, 0) = -dt * outflow - volume * sum_kappa(c, 0) * sum_dp(c, 0);
+          const double a = Kokkos::Experimental::fabs(rhs(c, 0)) / volume;
+          if (a > worst) worst = a;
+        },
+        Kokkos::Max<double>(local_max));
+  };
+  forMaterialCount(n, [&](auto count) {
+    if (after_solve) kernel(count, std::true_type());
+    else kernel(count, std::false_type());
+  });
   if (after_solve) {
     face_velocity_.swapValues(corrected_face_velocity_);
     face_velocity_.exchangeHalo();

@@ -355,9 +355,12 @@ void IceSolver<Dim>::momentumAndExchange(CellState<Dim>& state, double dt)
   auto v = state.specific_volume.view();
   const auto mu = viscosity_;
   const auto K = ice::ExchangeCoefficients::uniform(settings_.exchange_coefficient);
-  double h[3], g[3];
+  double h[3], inverse_h2[3], g[3];
   int no_slip[6];
-  for (int d = 0; d < Dim; ++d) h[d] = layout_->grid().spacing()[d], g[d] = gravity_[d];
+  for (int d = 0; d < Dim; ++d) {
+    h[d] = layout_->grid().spacing()[d], g[d] = gravity_[d];
+    inverse_h2[d] = 1.0 / (h[d] * h[d]);
+  }
   for (int f = 0; f < 2 * Dim; ++f) no_slip[f] = wall_no_slip_[f];
   // New velocities go to a copy so that the viscous stencil reads old values only.
   auto un = new_velocity_.view();
@@ -400,20 +403,20 @@ void IceSolver<Dim>::momentumAndExchange(CellState<Dim>& state, double dt)
               }
               // Viscous force per volume: θ_m μ_m ∇²u_k, so that the acceleration is ν_m ∇²u_k
               // whatever the material's share of the cell (a face-averaged θ would blow up where
-              // θ_c -> 0).
-              double viscous = 0;
-              for (int d = 0; d < Dim; ++d)
+              // θ_c -> 0). A no-slip wall holds u = 0 on the face, h/2 away.
+              double laplacian = 0;
+              for (int d = 0; d < Dim; ++d) {
+                double difference = 0;
                 for (int side = 0; side < 2; ++side) {
                   const int f = 2 * d + side;
                   const LocalOrdinal o = neighbour[f];
-                  if (o >= 0) {
-                    viscous += mu[m] * t[m] * (u(o, m * Dim + k) - uc) / (h[d] * h[d]);
-                  } else if (no_slip[f] && k != d) {
-                    viscous -= mu[m] * t[m] * 2.0 * uc / (h[d] * h[d]);
-                  }
+                  if (o >= 0) difference += u(o, m * Dim + k) - uc;
+                  else if (no_slip[f] && k != d) difference -= 2.0 * uc;
                 }
-              const double force = -t[m] * grad_p[k] + viscous + r[m] * g[k];  // per volume
-              vel[m][k] = uc + dt * force / r[m];
+                laplacian += difference * inverse_h2[d];
+              }
+              const double force = -t[m] * grad_p[k] + mu[m] * t[m] * laplacian + r[m] * g[k];  // per volume
+              vel[m][k] = uc + dt * force / r[m];  // (not dt / ρ first: ρ can be subnormal)
             }
             s[m] = v(c, m) * (1.0 - kappa(c, m) * sum_dp(c, 0));
             v(c, m) = s[m];

@@ -28,6 +28,7 @@ struct CellStencil {
   typename Layout<Dim>::IjkTable ijk;           // (cell, d) -> global index
   Kokkos::View<const LocalOrdinal**, MemorySpace> block;  // (cell, k) -> local id of the 3^Dim block
   double spacing[3] = {1, 1, 1};
+  double inverse_spacing[3] = {1, 1, 1};
   long long cells[3] = {1, 1, 1};
 
   CellStencil(const Layout<Dim>& layout, const Kokkos::View<LocalOrdinal**, MemorySpace>& block_table)
@@ -35,6 +36,7 @@ struct CellStencil {
   {
     for (int d = 0; d < 3; ++d) {
       spacing[d] = layout.grid().spacing()[d];
+      inverse_spacing[d] = 1.0 / spacing[d];
       cells[d] = layout.grid().cells()[d];
     }
   }
@@ -83,9 +85,9 @@ struct CellStencil {
   KOKKOS_INLINE_FUNCTION double gradient(const View& v, int c, const Local& l, int col, int d) const
   {
     const LocalOrdinal lower = l.neighbour[2 * d], upper = l.neighbour[2 * d + 1];
-    if (lower >= 0 && upper >= 0) return (v(upper, col) - v(lower, col)) / (2 * spacing[d]);
-    if (upper >= 0) return (v(upper, col) - v(c, col)) / spacing[d];
-    if (lower >= 0) return (v(c, col) - v(lower, col)) / spacing[d];
+    if (lower >= 0 && upper >= 0) return (v(upper, col) - v(lower, col)) * (0.5 * inverse_spacing[d]);
+    if (upper >= 0) return (v(upper, col) - v(c, col)) * inverse_spacing[d];
+    if (lower >= 0) return (v(c, col) - v(lower, col)) * inverse_spacing[d];
     return 0.0;
   }
 };
@@ -189,19 +191,19 @@ struct LargestOutflowReducer {
 KOKKOS_INLINE_FUNCTION double limiter(double value, double lo, double hi, double spread, double remaining,
                                       double S)
 {
-  double phi = 1.0;
+  // The smallest of 1, room / spread and bound / |S|, with one division: each candidate is a
+  // quotient a / b with b > 0, compared with the others by cross-multiplication.
+  double a = 1.0, b = 1.0;
   if (spread > 0) {
     const double room = (hi - value < value - lo ? hi - value : value - lo);
-    phi = room / spread < phi ? room / spread : phi;
+    if (room < spread) a = room, b = spread;
   }
-  if (S > 0) {
-    const double bound = remaining * (value - lo) / S;
-    phi = bound < phi ? bound : phi;
-  } else if (S < 0) {
-    const double bound = remaining * (hi - value) / (-S);
-    phi = bound < phi ? bound : phi;
+  if (S != 0) {
+    const double bound = S > 0 ? remaining * (value - lo) : remaining * (hi - value);
+    const double size = S > 0 ? S : -S;
+    if (bound * b < a * size) a = bound, b = size;
   }
-  return phi > 0 ? phi : 0.0;
+  return a > 0 ? a / b : 0.0;
 }
 
 }  // namespace

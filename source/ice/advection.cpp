@@ -160,14 +160,11 @@ struct LargestOutflowReducer {
   using result_view_type = Kokkos::View<value_type, Kokkos::HostSpace, Kokkos::MemoryUnmanaged>;
 
   explicit LargestOutflowReducer(value_type& result) : result_(&result) {}
-  KOKKOS_INLINE_FUNCTION void join(value_type& best, const value_type& other) const
-  {
-    best.include(other.value, other.key);
-  }
   KOKKOS_INLINE_FUNCTION void join(volatile value_type& best, const volatile value_type& other) const
   {
-    if (other.value > best.value || (other.value == best.value && other.key < best.key))
-      best.value = other.value, best.key = other.key;
+    value_type joined{best.value, best.key};
+    joined.include(other.value, other.key);
+    best.value = joined.value, best.key = joined.key;
   }
   KOKKOS_INLINE_FUNCTION void init(value_type& best) const
   {

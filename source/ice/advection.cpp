@@ -64,16 +64,15 @@ struct CellStencil {
   }
 
   /// Minimum and maximum of column `col` over the cell and its 3^Dim - 1 neighbours (diagonals
-  /// included) that are inside the domain and held by this rank.
+  /// included) that are inside the domain and held by this rank (the block table names the cell
+  /// itself in place of the others, which leaves the bounds as they are).
   template <class View>
   KOKKOS_INLINE_FUNCTION void blockBounds(const View& v, int c, const Local& l, int col, double& lo,
                                           double& hi) const
   {
     lo = hi = v(c, col);
     for (int k = 0; k < kBlock; ++k) {
-      const LocalOrdinal n = l.block[k];
-      if (n < 0) continue;
-      const double value = v(n, col);
+      const double value = v(l.block[k], col);
       lo = value < lo ? value : lo;
       hi = value > hi ? value : hi;
     }
@@ -236,7 +235,10 @@ Advector<Dim>::Advector(std::shared_ptr<const Layout<Dim>> layout, int materials
         int slot = 0;
         for (int dk = -kw; dk <= kw; ++dk)
           for (int dj = -1; dj <= 1; ++dj)
-            for (int di = -1; di <= 1; ++di) block(c, slot++) = lookup(i + di, j + dj, k + dk);
+            for (int di = -1; di <= 1; ++di) {
+              const LocalOrdinal n = lookup(i + di, j + dj, k + dk);
+              block(c, slot++) = n >= 0 ? n : c;  // none there: the cell itself (no branch in the bounds)
+            }
       });
   outflow_mass_ = WorkView("advection outflow mass", cells, 2 * Dim, materials);
 }

@@ -93,8 +93,8 @@ class Advector {
   std::shared_ptr<const Layout<Dim>> layout_;
   int materials_;
   Options options_;
-  // Per local cell: the local ids of its 3^Dim block (itself included), < 0 where there is none
-  // held by this rank; built once, read by the limiter bounds.
+  // Per local cell: the local ids of its 3^Dim block (itself included), the cell's own id where
+  // there is none held by this rank; built once, read by the limiter bounds.
   Kokkos::View<LocalOrdinal**, MemorySpace> block_;
   // Per local cell (owned and ghost), face f = 2 d + side and material: the mass leaving the cell
   // through f in this step (>= 0).

@@ -300,20 +300,25 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
             sum_dp(c, 0) += dp(c, 0);
             p(c, 0) = p_eq(c, 0) + sum_dp(c, 0);
           }
+          // Velocity of material m on the lower face of cell `upper` in direction d (below it:
+          // cell `lower`), corrected with this iteration's δp when kCorrect.
+          const auto faceVelocity = [&](int d, int m, LocalOrdinal upper, LocalOrdinal lower) {
+            const double w = uf[d](upper, m);
+            return kCorrect ? w - dt_per_h[d] * vf[d](upper, m) * (dp(upper, 0) - dp(lower, 0)) : w;
+          };
           double outflow = 0;  // Σ_faces A Σ_m θ_upwind u · n_out  (m^3/s)
           for (int d = 0; d < Dim; ++d) {
             const LocalOrdinal l = neighbours(c, 2 * d), r = neighbours(c, 2 * d + 1);
             for (int m = 0; m < nm; ++m) {
               if (l >= 0) {  // lower face, outward normal −e_d
-                double w = uf[d](c, m);
-                if (kCorrect) corrected[d](c, m) = w = w - dt_per_h[d] * vf[d](c, m) * (dp(c, 0) - dp(l, 0));
+                const double w = faceVelocity(d, m, c, l);
+                if (kCorrect) corrected[d](c, m) = w;
                 outflow -= area[d] * w * (w > 0 ? theta(l, m) : theta(c, m));
               } else if (kCorrect) {
                 corrected[d](c, m) = uf[d](c, m);  // a wall: stays zero
               }
               if (r >= 0) {  // upper face, stored on the upper neighbour
-                double w = uf[d](r, m);
-                if (kCorrect) w = w - dt_per_h[d] * vf[d](r, m) * (dp(r, 0) - dp(c, 0));
+                const double w = faceVelocity(d, m, r, c);
                 outflow += area[d] * w * (w > 0 ? theta(c, m) : theta(r, m));
               }
             }

@@ -10,6 +10,7 @@
 #include <optional>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 #include <type_traits>
 
@@ -42,6 +43,25 @@ KOKKOS_INLINE_FUNCTION double followMixtureVelocity(int n, const Density& rho, c
     if (!(rho(m) > kNegligibleMassShare * mass))
       for (int d = 0; d < Dim; ++d) u(m, d) = momentum[d] / (mass + kTiny);
   return mass;
+}
+
+// A rigid material moves at its prescribed velocity whatever the forces on it: in the exchange it
+// enters with its specific volume divided (its mass density multiplied) by this factor, i.e. with
+// an inertia so large that the other materials relax to its velocity and it keeps its own. At the
+// same time its face specific volume (the pressure equation's coefficient) vanishes, so faces where
+// it is present carry no pressure-driven flow: a cell filled by the body acts as a wall.
+constexpr double kRigidInertia = 1e30;
+
+// The exchange coefficients between every pair: the scene's K between fluids and between a fluid
+// and a solid; zero between two solids (MPM's contact acts between them, with friction and free
+// separation; a drag would make a sliding body stick to the bed).
+ice::ExchangeCoefficients pairCoefficients(double coefficient, int materials, const MaterialRoles& roles)
+{
+  ice::ExchangeCoefficients K = ice::ExchangeCoefficients::uniform(coefficient);
+  for (int m = 0; m < materials; ++m)
+    for (int n = 0; n < materials; ++n)
+      if (m != n && roles.lagrangian[m] && roles.lagrangian[n]) K.set(m, n, 0.0);
+  return K;
 }
 
 // Calls f(std::integral_constant<int, N>()): N = 2 for two materials, so that the kernels' loops over
@@ -90,7 +110,8 @@ IceSettings IceSettings::fromScene(const Scene& scene)
 }
 
 template <int Dim>
-IceSolver<Dim>::IceSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>> layout)
+IceSolver<Dim>::IceSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>> layout,
+                          const std::vector<SolidProperties>& solids)
     : scene_(scene),
       settings_(IceSettings::fromScene(scene)),
       layout_(layout),
@@ -113,14 +134,33 @@ IceSolver<Dim>::IceSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>>
                      std::to_string(ice::kMaxMaterials) + " are allowed");
   for (int m = 0; m < materials_; ++m) {
     const MaterialSpec& material = scene.materials[m];
-    if (material.kind != "fluid")
-      throw InputError("cfdmpm.materials." + material.name + ".kind: got 'solid'; the fluid solver "
-                       "of this version runs fluid materials only");
+    names_.push_back(material.name);
+    if (material.kind != "fluid") {
+      const SolidProperties* solid = nullptr;
+      for (const SolidProperties& s : solids)
+        if (s.material == m) solid = &s;
+      if (!solid)
+        throw InputError("cfdmpm.materials." + material.name + ".kind: got 'solid'; the fluid step alone "
+                         "runs fluid materials only (solids need the coupled step)");
+      if (!settings_.isothermal)
+        throw InputError("cfdmpm.ice.isothermal: got 'false' in a scene with the solid material '" + material.name +
+                         "'; allowed: true. The coupled step does not carry the solids' temperature yet, so "
+                         "their heat exchange with the fluids would be missing");
+      roles_.lagrangian[m] = 1;
+      roles_.rigid[m] = solid->rigid ? 1 : 0;
+      roles_.any_solid = true;
+      bulk_modulus_[m] = solid->bulk_modulus;
+      // The reference density and pressure are replaced per cell in the equilibration.
+      eos_[m] = ice::SolidEos(solid->bulk_modulus, solid->density, scene.initial.pressure);
+      viscosity_[m] = 0.0;
+      specific_heat_[m] = 1.0;  // isothermal: not used
+      conductivity_[m] = 0.0;
+      continue;
+    }
     eos_[m] = fluidEos(material);
     viscosity_[m] = material.parameters.get<double>("viscosity");
     specific_heat_[m] = material.parameters.get<double>("specific_heat");
     conductivity_[m] = material.parameters.get<double>("thermal_conductivity");
-    names_.push_back(material.name);
   }
   for (int d = 0; d < 3; ++d) gravity_[d] = d < Dim ? scene.domain.gravity[d] : 0.0;
   for (int f = 0; f < 2 * Dim; ++f) wall_no_slip_[f] = 1, wall_temperature_[f] = -1;
@@ -139,11 +179,18 @@ template <int Dim>
 IceSolver<Dim>::~IceSolver() = default;
 
 // [3] Equilibration pressure: per cell, the pressure at which the materials' volumes fill it.
+// A solid's equation of state is taken about its state in the cell: its cell volume fraction on
+// entry (from the particles' volumes) at the cell's pressure on entry, with the stiffness of its bulk
+// modulus, ρ_micro(p) = (ρ_s/θ_s) / (1 − (p − p_old)/K). A cell that the solid fills alone keeps its
+// pressure (the pore pressure that the pressure equation carries), and the solid's share of a mixed
+// cell changes only by what the pressure change compresses it.
 template <int Dim>
 int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
 {
   const int n = materials_;
   const auto eos = eos_;
+  const auto roles = roles_;
+  const auto bulk = bulk_modulus_;
   auto rho = state.density.view();
   auto T = state.temperature.view();
   auto theta = state.volume_fraction.view();
@@ -152,8 +199,9 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
   auto kappa = compressibility_.view();
   auto sum_kappa = mixture_compressibility_.view();
   int failures = 0;
-  forMaterialCount(n, [&](auto count) {
+  const auto kernel = [&](auto count, auto with_solids) {
     constexpr int N = decltype(count)::value;
+    constexpr bool kSolids = decltype(with_solids)::value;
     Kokkos::parallel_reduce(
         "ice::equilibrate", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
         KOKKOS_LAMBDA(const LocalOrdinal c, int& failed) {
@@ -163,8 +211,16 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
             mass_density[m] = rho(c, m) > 0 ? rho(c, m) : 0.0;
             temperature[m] = T(c, m);
           }
-          const ice::EquilibrationResult r =
-              ice::equilibrationPressure<N>(nm, eos, mass_density, temperature, p(c, 0));
+          ice::EquilibrationResult r;
+          if constexpr (kSolids) {
+            ice::MaterialArray<ice::Eos> local = eos;
+            for (int m = 0; m < nm; ++m)
+              if (roles.lagrangian[m] && mass_density[m] > 0 && theta(c, m) > 0)
+                local[m] = ice::SolidEos(bulk[m], mass_density[m] / theta(c, m), p(c, 0));
+            r = ice::equilibrationPressure<N>(nm, local, mass_density, temperature, p(c, 0));
+          } else {
+            r = ice::equilibrationPressure<N>(nm, eos, mass_density, temperature, p(c, 0));
+          }
           if (!r.converged()) ++failed;
           p(c, 0) = r.pressure;
           double sk = 0;
@@ -177,6 +233,10 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
           sum_kappa(c, 0) = sk;
         },
         failures);
+  };
+  forMaterialCount(n, [&](auto count) {
+    if (roles_.any_solid) kernel(count, std::true_type());
+    else kernel(count, std::false_type());
   });
   for (Field<Dim>* f : {&state.volume_fraction, &state.specific_volume, &state.pressure, &compressibility_,
                         &mixture_compressibility_})
@@ -201,7 +261,8 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
   const auto theta = state.volume_fraction.view();
   const auto v = state.specific_volume.view();
   const auto p = state.pressure.view();
-  const auto K = ice::ExchangeCoefficients::uniform(settings_.exchange_coefficient);
+  const auto K = pairCoefficients(settings_.exchange_coefficient, n, roles_);
+  const auto roles = roles_;
   forMaterialCount(n, [&](auto count) {
     constexpr int N = decltype(count)::value;
     for (int d = 0; d < Dim; ++d) {
@@ -228,7 +289,12 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
               const double ul = u(l, m * Dim + d), ur = u(c, m * Dim + d);
               const double mean = (rl * ul + rr * ur) / (rl + rr + kTiny);
               const double vbar = 2.0 * vl[m] * vr[m] / (vl[m] + vr[m]);
-              vel[m] = mean - dt_per_h * vbar * pressure_difference + dt * g;
+              // A solid's cell velocity already holds gravity and its stress (the MPM grid's v*).
+              // A rigid body does not accelerate at all.
+              vel[m] = roles.rigid[m]        ? mean
+                       : roles.lagrangian[m] ? mean - dt_per_h * vbar * pressure_difference
+                                             : mean - dt_per_h * vbar * pressure_difference + dt * g;
+              if (roles.rigid[m]) vl[m] /= kRigidInertia, vr[m] /= kRigidInertia;
             }
             ice::exchangeMomentumFC<N>(nm, dt, K, tl, tr, vl, vr, vel, sv);
             // A material absent on both sides has no weight in the exchange and would keep its own
@@ -342,16 +408,21 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
   return global_max / volume;  // max_c |rhs_c| / V (the same as the largest quotient: V > 0)
 }
 
-// [6] + [8] Momentum sources and Lagrangian values, then the implicit cell-centred momentum exchange
-// (Uintah addExch_Vel_Temp_CC, momentum part), in one pass. Face pressure p_f weighted by the summed
-// densities of the two cells (Uintah computePressFC); force on material m: −θ_m V ∇p_f, Newtonian
-// viscous stress (θ μ ∇²u per material), gravity. The Lagrangian specific volume follows the pressure
-// change: v_L = v (1 − κ_m Σδp) (Uintah computeLagrangianSpecificVolume, isothermal). The exchange is
-// pointwise, so it acts on the cell's new velocities before they are stored; a material with a
-// negligible share of the mass then takes the mixture's velocity.
+// [6] Momentum sources and Lagrangian velocities. Face pressure p_f weighted by the summed fluid
+// densities of the two cells (Uintah computePressFC); force on material m: −θ_m V ∇p_f, and on fluids
+// Newtonian viscous stress (θ μ ∇²u per material) and gravity. Solids get the pressure force only:
+// their stress and gravity act on the MPM grid, whose velocity their cell velocity already is. The
+// Lagrangian specific volume follows the pressure change: v_L = v (1 − κ_m Σδp) (Uintah
+// computeLagrangianSpecificVolume, isothermal). New velocities go to lagrangianVelocity().
 template <int Dim>
-void IceSolver<Dim>::momentumAndExchange(CellState<Dim>& state, double dt)
+void IceSolver<Dim>::momentumSourcePhase(CellState<Dim>& state, double dt)
 {
+  Teuchos::TimeMonitor phase(*timers_.at("momentum"));
+  state.pressure.exchangeHalo();
+  if (!settings_.isothermal) {
+    Kokkos::deep_copy(old_specific_volume_.view(), state.specific_volume.view());
+    state.temperature.exchangeHalo();
+  }
   const int n = materials_;
   const auto neighbours = layout_->cellNeighbours();
   const auto theta = state.volume_fraction.view();
@@ -359,10 +430,10 @@ void IceSolver<Dim>::momentumAndExchange(CellState<Dim>& state, double dt)
   const auto p = state.pressure.view();
   const auto kappa = compressibility_.view();
   const auto sum_dp = sum_delta_p_.view();
-  auto u = state.velocity.view();
+  const auto u = state.velocity.view();
   auto v = state.specific_volume.view();
   const auto mu = viscosity_;
-  const auto K = ice::ExchangeCoefficients::uniform(settings_.exchange_coefficient);
+  const auto roles = roles_;
   double h[3], inverse_h2[3], g[3];
   int no_slip[6];
   for (int d = 0; d < Dim; ++d) {
@@ -370,7 +441,7 @@ void IceSolver<Dim>::momentumAndExchange(CellState<Dim>& state, double dt)
     inverse_h2[d] = 1.0 / (h[d] * h[d]);
   }
   for (int f = 0; f < 2 * Dim; ++f) no_slip[f] = wall_no_slip_[f];
-  // New velocities go to a copy so that the viscous stencil reads old values only.
+  // New velocities go to a second field so that the viscous stencil reads old values only.
   auto un = new_velocity_.view();
   forMaterialCount(n, [&](auto count) {
     constexpr int N = decltype(count)::value;
@@ -380,10 +451,12 @@ void IceSolver<Dim>::momentumAndExchange(CellState<Dim>& state, double dt)
           const int nm = N > 0 ? N : n;
           LocalOrdinal neighbour[2 * Dim];
           for (int f = 0; f < 2 * Dim; ++f) neighbour[f] = neighbours(c, f);
-          ice::MaterialArray<double> r{}, t{}, s{};
+          ice::MaterialArray<double> r{}, t{};
           for (int m = 0; m < nm; ++m) r[m] = rho(c, m), t[m] = theta(c, m);
+          // The fluids' density sets the hydrostatic pressure profile (a solid's weight rests on
+          // its own stress, not on the pore pressure).
           double sum_rho_c = 0;
-          for (int m = 0; m < nm; ++m) sum_rho_c += r[m];
+          for (int m = 0; m < nm; ++m) sum_rho_c += roles.lagrangian[m] ? 0.0 : r[m];
           double grad_p[3] = {0, 0, 0};
           for (int d = 0; d < Dim; ++d) {
             double face_p[2];
@@ -396,17 +469,22 @@ void IceSolver<Dim>::momentumAndExchange(CellState<Dim>& state, double dt)
                 continue;
               }
               double sum_rho_o = 0;
-              for (int m = 0; m < nm; ++m) sum_rho_o += rho(o, m);
-              face_p[side] = (p(o, 0) * sum_rho_c + p(c, 0) * sum_rho_o) / (sum_rho_c + sum_rho_o + kTiny);
+              for (int m = 0; m < nm; ++m) sum_rho_o += roles.lagrangian[m] ? 0.0 : rho(o, m);
+              face_p[side] = sum_rho_c + sum_rho_o > 0
+                                 ? (p(o, 0) * sum_rho_c + p(c, 0) * sum_rho_o) / (sum_rho_c + sum_rho_o + kTiny)
+                                 : 0.5 * (p(o, 0) + p(c, 0));  // two cells of solids alone
             }
             grad_p[d] = (face_p[1] - face_p[0]) / h[d];
           }
-          ice::MaterialArray<Kokkos::Array<double, Dim>> vel{};
           for (int m = 0; m < nm; ++m) {
             for (int k = 0; k < Dim; ++k) {
               const double uc = u(c, m * Dim + k);
-              if (!(r[m] > 0)) {  // no mass of m here: no force to apply
-                vel[m][k] = uc;
+              if (!(r[m] > 0) || roles.rigid[m]) {  // no mass of m here, or a rigid body: no force to apply
+                un(c, m * Dim + k) = uc;
+                continue;
+              }
+              if (roles.lagrangian[m]) {
+                un(c, m * Dim + k) = uc + dt * (-t[m] * grad_p[k]) / r[m];
                 continue;
               }
               // Viscous force per volume: θ_m μ_m ∇²u_k, so that the acceleration is ν_m ∇²u_k
@@ -424,21 +502,77 @@ void IceSolver<Dim>::momentumAndExchange(CellState<Dim>& state, double dt)
                 laplacian += difference * inverse_h2[d];
               }
               const double force = -t[m] * grad_p[k] + mu[m] * t[m] * laplacian + r[m] * g[k];  // per volume
-              vel[m][k] = uc + dt * force / r[m];  // (not dt / ρ first: ρ can be subnormal)
+              un(c, m * Dim + k) = uc + dt * force / r[m];  // (not dt / ρ first: ρ can be subnormal)
             }
-            s[m] = v(c, m) * (1.0 - kappa(c, m) * sum_dp(c, 0));
-            v(c, m) = s[m];
+            v(c, m) = v(c, m) * (1.0 - kappa(c, m) * sum_dp(c, 0));
           }
-          ice::exchangeMomentumCC<Dim, N>(nm, dt, K, r, t, s, vel);
+        });
+  });
+}
+
+// [8] The implicit cell-centred momentum exchange (Uintah addExch_Vel_Temp_CC, momentum part) on the
+// Lagrangian velocities, pointwise; a material with a negligible share of the mass then takes the
+// mixture's velocity. A rigid material enters with an inertia that keeps its velocity (kRigidInertia).
+// The exchanged velocities become the state's; then the energy, unless isothermal. Cells whose
+// exchange is not finite are counted in the report (the caller stops the run).
+template <int Dim>
+void IceSolver<Dim>::exchangePhase(CellState<Dim>& state, double dt, IceStepReport& report)
+{
+  Teuchos::TimeMonitor phase(*timers_.at("exchange"));
+  const int n = materials_;
+  const auto theta = state.volume_fraction.view();
+  const auto rho = state.density.view();
+  const auto v = state.specific_volume.view();
+  const auto K = pairCoefficients(settings_.exchange_coefficient, n, roles_);
+  const auto roles = roles_;
+  const auto ijk = layout_->cellIndex();
+  const long long nx = layout_->grid().cells()[0], ny = layout_->grid().cells()[1];
+  auto un = new_velocity_.view();
+  // Failures are rare: counted with atomics (Kokkos 3.4 has no reduction over two reducers).
+  Kokkos::View<int, MemorySpace> bad("exchange failures");
+  Kokkos::View<long long, MemorySpace> first("first failed cell");
+  Kokkos::deep_copy(first, std::numeric_limits<long long>::max());
+  forMaterialCount(n, [&](auto count) {
+    constexpr int N = decltype(count)::value;
+    Kokkos::parallel_for(
+        "ice::exchangeCC", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+        KOKKOS_LAMBDA(const LocalOrdinal c) {
+          const int nm = N > 0 ? N : n;
+          ice::MaterialArray<double> r{}, t{}, s{};
+          ice::MaterialArray<Kokkos::Array<double, Dim>> vel{};
+          for (int m = 0; m < nm; ++m) {
+            r[m] = rho(c, m), t[m] = theta(c, m), s[m] = v(c, m);
+            if (roles.rigid[m]) r[m] *= kRigidInertia, s[m] /= kRigidInertia;
+            for (int d = 0; d < Dim; ++d) vel[m][d] = un(c, m * Dim + d);
+          }
+          const ice::ExchangeStatus status = ice::exchangeMomentumCC<Dim, N>(nm, dt, K, r, t, s, vel);
+          if (status != ice::ExchangeStatus::Ok) {
+            Kokkos::atomic_add(&bad(), 1);
+            const long long gid = ijk(c, 0) + nx * (ijk(c, 1) + (Dim == 3 ? ny * ijk(c, 2) : 0));
+            Kokkos::atomic_fetch_min(&first(), gid);
+          }
+          for (int m = 0; m < nm; ++m)
+            if (roles.rigid[m]) r[m] /= kRigidInertia;
           followMixtureVelocity<Dim>(
               nm, [&](int m) { return r[m]; }, [&](int m, int d) -> double& { return vel[m][d]; });
           for (int m = 0; m < nm; ++m)
             for (int d = 0; d < Dim; ++d) un(c, m * Dim + d) = vel[m][d];
         });
   });
-  // The new velocities become the state's; their ghosts are refreshed by the advection, the next
-  // reader. The old ones are work space from now on.
+  int failures = 0, total = 0;
+  long long local_first = 0, global_first = 0;
+  Kokkos::deep_copy(failures, bad);
+  Kokkos::deep_copy(local_first, first);
+  Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_SUM, failures, Teuchos::outArg(total));
+  if (total > 0) {
+    Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_MIN, local_first, Teuchos::outArg(global_first));
+    report.exchange_failures += total;
+    if (report.first_failed_cell < 0 || global_first < report.first_failed_cell) report.first_failed_cell = global_first;
+  }
+  // The new velocities become the state's; their ghosts are refreshed by the next reader. The old
+  // ones are work space from now on.
   state.velocity.swapValues(new_velocity_);
+  if (!settings_.isothermal) energy(state, old_specific_volume_, dt);
 }
 
 // Energy (when not isothermal), per material with e = c_v T: the work of the pressure on the volume
@@ -497,23 +631,40 @@ IceStepReport IceSolver<Dim>::step(CellState<Dim>& state, double dt)
 {
   IceStepReport report;
   Teuchos::TimeMonitor whole(*timers_.at("step"));
-  // [3] Equilibration pressure, volume fractions, specific volumes, compressibilities.
-  {
-    Teuchos::TimeMonitor phase(*timers_.at("equilibration"));
-    report.equilibration_failures = equilibrate(state);
-    Kokkos::deep_copy(equilibrium_pressure_.view(), state.pressure.view());
-  }
+  equilibrationPhase(state, report);   // [3]
+  faceVelocityPhase(state, dt);        // [4]
+  pressurePhase(state, dt, report);    // [5]
+  momentumSourcePhase(state, dt);      // [6]
+  exchangePhase(state, dt, report);    // [8]
+  advectionPhase(state, dt, report);   // [10]
+  return report;
+}
 
-  // [4] Face velocities and face exchange.
-  {
-    Teuchos::TimeMonitor phase(*timers_.at("face velocities"));
-    state.velocity.exchangeHalo();
-    state.density.exchangeHalo();
-    faceVelocities(state, dt);
-  }
+// [3] Equilibration pressure, volume fractions, specific volumes, compressibilities; the pressure
+// correction starts from this pressure.
+template <int Dim>
+void IceSolver<Dim>::equilibrationPhase(CellState<Dim>& state, IceStepReport& report)
+{
+  Teuchos::TimeMonitor phase(*timers_.at("equilibration"));
+  report.equilibration_failures = equilibrate(state);
+  Kokkos::deep_copy(equilibrium_pressure_.view(), state.pressure.view());
+}
 
-  // [5] Pressure correction with outer iterations (implicit), or one explicit update.
-  std::optional<Teuchos::TimeMonitor> pressure_phase(std::in_place, *timers_.at("pressure"));
+// [4] Face velocities and face exchange.
+template <int Dim>
+void IceSolver<Dim>::faceVelocityPhase(CellState<Dim>& state, double dt)
+{
+  Teuchos::TimeMonitor phase(*timers_.at("face velocities"));
+  state.velocity.exchangeHalo();
+  state.density.exchangeHalo();
+  faceVelocities(state, dt);
+}
+
+// [5] Pressure correction with outer iterations (implicit), or one explicit update.
+template <int Dim>
+void IceSolver<Dim>::pressurePhase(CellState<Dim>& state, double dt, IceStepReport& report)
+{
+  Teuchos::TimeMonitor phase(*timers_.at("pressure"));
   sum_delta_p_.fill(0.0);
   const bool implicit = settings_.pressure == "implicit";
   if (implicit) pressure_solver_->assemble(mixture_compressibility_, face_beta_, dt);
@@ -570,22 +721,29 @@ IceStepReport IceSolver<Dim>::step(CellState<Dim>& state, double dt)
   report.outer_residual = residual;
   report.converged = residual <= settings_.outer_tolerance || !implicit;
 
-  pressure_phase.reset();
 
-  // [6] + [8] Momentum sources, Lagrangian values, cell-centred exchange.
-  {
-    Teuchos::TimeMonitor phase(*timers_.at("momentum and exchange"));
-    state.pressure.exchangeHalo();
-    if (!settings_.isothermal) {
-      Kokkos::deep_copy(old_specific_volume_.view(), state.specific_volume.view());
-      state.temperature.exchangeHalo();
+}
+
+// [10] Advection of mass, velocity and specific volume of the fluids by the corrected face
+// velocities. Solids are Lagrangian: their face velocities are zero here, so their cell columns do
+// not move (the next step takes them from the particles again).
+template <int Dim>
+void IceSolver<Dim>::advectionPhase(CellState<Dim>& state, double dt, IceStepReport& report)
+{
+  Teuchos::TimeMonitor phase(*timers_.at("advection"));
+  if (roles_.any_solid) {
+    const int n = materials_;
+    const auto roles = roles_;
+    for (int d = 0; d < Dim; ++d) {
+      auto uf = face_velocity_.direction(d).view();
+      Kokkos::parallel_for(
+          "ice::holdSolids", Kokkos::RangePolicy<ExecutionSpace>(0, state.density.overlapCount()),
+          KOKKOS_LAMBDA(const LocalOrdinal c) {
+            for (int m = 0; m < n; ++m)
+              if (roles.lagrangian[m]) uf(c, m) = 0.0;
+          });
     }
-    momentumAndExchange(state, dt);
-    if (!settings_.isothermal) energy(state, old_specific_volume_, dt);
   }
-
-  // [10] Advection of mass, velocity and specific volume by the corrected face velocities.
-  std::optional<Teuchos::TimeMonitor> advection_phase(std::in_place, *timers_.at("advection"));
   std::vector<Field<Dim>*> carried{&state.velocity, &state.specific_volume};
   if (!settings_.isothermal) carried.push_back(&state.temperature);  // c_v T is the energy per mass
   const AdvectionStatus advected = advector_->advect(face_velocity_, dt, state.density, carried);
@@ -619,7 +777,6 @@ IceStepReport IceSolver<Dim>::step(CellState<Dim>& state, double dt)
           });
     });
   }
-  return report;
 }
 
 template <int Dim>

@@ -10,14 +10,17 @@
 //   [10] conservative second-order advection
 //   [11] next Δt from convective CFL, viscosity and conduction
 //
-// The state is the shared CellState, so solid (MPM) materials can join the same equilibration,
-// pressure and exchange later. Isothermal by default (the scene key `ice.isothermal`).
+// The state is the shared CellState of all materials. Solid (MPM) materials take part in the
+// equilibration (an equation of state from their bulk modulus), the face velocities and face
+// exchange, the pressure equation and the cell-centred exchange; they are not advected and get no
+// gravity or viscosity here (their cell velocity comes from the MPM grid with those forces already
+// in it; mpmice/mpmice_step.hpp). Isothermal by default (the scene key `ice.isothermal`).
 #include "ice/advection.hpp"
 #include "ice/eos.hpp"
 #include "ice/face_field.hpp"
 #include "ice/pressure_solver.hpp"
 #include "input/scene.hpp"
-#include "mpmice/cell_state.hpp"
+#include "fields/cell_state.hpp"
 
 #include <Teuchos_Time.hpp>
 
@@ -51,9 +54,20 @@ struct IceStepReport {
   int outer_iterations = 0;
   int linear_iterations = 0;      // summed over the outer iterations
   double outer_residual = 0;      // max |rhs| / V at the end (a fraction of the cell volume)
-  bool converged = true;
-  int equilibration_failures = 0;
+  bool converged = true;          // the outer iteration reached outer_tolerance
+  int equilibration_failures = 0; // cells whose equilibration pressure did not converge
+  int exchange_failures = 0;      // cells or faces whose exchange gave a value that is not finite
+  long long first_failed_cell = -1;  // global id of the lowest such cell (either kind), or -1
   double max_outflux_fraction = 0;
+};
+
+/// What the ICE step needs to know of each material: fluid (Eulerian, advected, gravity and
+/// viscosity here) or solid (Lagrangian: MPM carries it), and whether a solid is rigid (moves at a
+/// prescribed velocity whatever the forces: infinite inertia in the exchange).
+struct MaterialRoles {
+  ice::MaterialArray<int> lagrangian{};
+  ice::MaterialArray<int> rigid{};
+  bool any_solid = false;
 };
 
 /// The time-step limit and what set it.
@@ -62,15 +76,51 @@ struct TimeStepLimit {
   std::string limiter;  // e.g. "convection(water)", "viscosity(air)", "dt_max", "growth"
 };
 
+/// A solid (MPM) material as the ICE phases see it (the coupled step fills these from the MPM
+/// materials, so that ice/ needs nothing of mpm/).
+struct SolidProperties {
+  int material = 0;           // index in Scene::materials
+  double bulk_modulus = 0.0;  // K of its equation of state (Pa)
+  double density = 0.0;       // at rest (kg/m^3)
+  bool rigid = false;
+};
+
 template <int Dim>
 class IceSolver {
  public:
-  IceSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>> layout);
+  /// `solids` describes every `kind: solid` material of the scene; without it a scene with solids
+  /// is refused (the fluid step alone runs fluids only).
+  IceSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>> layout,
+            const std::vector<SolidProperties>& solids = {});
   ~IceSolver();
 
-  /// Advances the state by dt. Throws std::runtime_error (on every rank) if the step fails in a
-  /// way a smaller Δt cannot fix, naming the cell and material.
+  /// Advances a state of fluids only by dt: the phases below in order. Throws std::runtime_error
+  /// (on every rank) if the step fails in a way a smaller Δt cannot fix, naming the cell and
+  /// material.
   IceStepReport step(CellState<Dim>& state, double dt);
+
+  // --- the phases of the step, in order; the coupled step (mpmice/) calls them between its
+  //     particle phases. Each is collective and leaves the ghosts it promises refreshed.
+  /// [3] Equilibration pressure (see equilibrate below) and the pressure the correction starts from.
+  void equilibrationPhase(CellState<Dim>& state, IceStepReport& report);
+  /// [4] Face velocities and the implicit face exchange (needs the state's velocity and density).
+  void faceVelocityPhase(CellState<Dim>& state, double dt);
+  /// [5] Pressure correction: outer iterations of the implicit pressure equation (or one explicit
+  /// update); faces corrected. Throws if a linear solve fails.
+  void pressurePhase(CellState<Dim>& state, double dt, IceStepReport& report);
+  /// [6] Momentum sources: face pressure, the pressure force on every material (θ V ∇p_f), and on
+  /// fluids viscosity and gravity; gives the Lagrangian velocities (lagrangianVelocity()).
+  void momentumSourcePhase(CellState<Dim>& state, double dt);
+  /// [8] Lagrangian specific volume, implicit cell-centred momentum exchange between all
+  /// materials, and energy (unless isothermal); the exchanged velocities become the state's.
+  void exchangePhase(CellState<Dim>& state, double dt, IceStepReport& report);
+  /// [10] Advection of the fluids (solids are Lagrangian) and the cell closure θ = ρ v.
+  void advectionPhase(CellState<Dim>& state, double dt, IceStepReport& report);
+
+  /// Velocities after the momentum sources, before the exchange (valid between
+  /// momentumSourcePhase and exchangePhase; afterwards work space).
+  const Field<Dim>& lagrangianVelocity() const { return new_velocity_; }
+  const MaterialRoles& roles() const { return roles_; }
 
   /// The largest stable Δt for the state (convective CFL and viscous limits), at most
   /// growth × previous_dt and within [dt_min, dt_max].
@@ -83,22 +133,23 @@ class IceSolver {
   const IceSettings& settings() const { return settings_; }
 
   /// The phases timed by Teuchos timers named "ice: <phase>" ("step" is the whole step).
-  static constexpr const char* kPhases[] = {"step", "equilibration", "face velocities", "pressure",
-                                            "momentum and exchange", "advection"};
+  static constexpr const char* kPhases[] = {"step",     "equilibration", "face velocities", "pressure",
+                                            "momentum", "exchange",      "advection"};
   /// Wall seconds spent in a phase on this rank since the program started.
   double phaseSeconds(const std::string& phase) const { return timers_.at(phase)->totalElapsedTime(); }
 
  private:
   void faceVelocities(const CellState<Dim>& state, double dt);
   double pressureRightHandSide(CellState<Dim>& state, double dt, bool after_solve);
-  void momentumAndExchange(CellState<Dim>& state, double dt);
   void energy(CellState<Dim>& state, const Field<Dim>& old_specific_volume, double dt);
 
   Scene scene_;
   IceSettings settings_;
   std::shared_ptr<const Layout<Dim>> layout_;
   int materials_;
+  MaterialRoles roles_;
   ice::MaterialArray<ice::Eos> eos_;
+  ice::MaterialArray<double> bulk_modulus_;  // solids: K of their equation of state (Pa)
   ice::MaterialArray<double> viscosity_;
   ice::MaterialArray<double> specific_heat_;
   ice::MaterialArray<double> conductivity_;
@@ -115,7 +166,7 @@ class IceSolver {
   FaceField<Dim> corrected_face_velocity_;  // work array of the pressure correction
   FaceField<Dim> face_specific_volume_; // per material, after the face exchange
   FaceField<Dim> face_beta_;            // Σ θ_f v_f
-  Field<Dim> new_velocity_;             // work array of the momentum update
+  Field<Dim> new_velocity_;             // Lagrangian velocities between sources and exchange
   Field<Dim> old_specific_volume_;      // v before the Lagrangian update (for the p dv work)
   std::unique_ptr<PressureSolver<Dim>> pressure_solver_;
   std::unique_ptr<Advector<Dim>> advector_;

@@ -24,19 +24,4 @@ ice::Eos fluidEos(const MaterialSpec& material)
                    "'; allowed: linear_water, ideal_gas, tait");
 }
 
-std::vector<DensityOfState> densityFunctions(const Scene& scene)
-{
-  std::vector<DensityOfState> result;
-  for (const MaterialSpec& material : scene.materials) {
-    if (material.kind == "fluid") {
-      const ice::Eos eos = fluidEos(material);
-      result.emplace_back([eos](double p, double T) { return eos.density(p, T); });
-    } else {
-      const double rho = material.parameters.get<double>("density");
-      result.emplace_back([rho](double, double) { return rho; });
-    }
-  }
-  return result;
-}
-
 }  // namespace cfdmpm

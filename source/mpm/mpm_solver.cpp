@@ -538,6 +538,206 @@ void MpmSolver<Dim>::gridToParticlesWith(double dt)
   bins_current_ = false;  // the particles moved
 }
 
+namespace {
+
+/// The cells that the GIMP domain of a particle (the box [x_p - l_p, x_p + l_p] per direction)
+/// overlaps, and the share of the box in each: at most two cells per direction (l_p <= h/2). The
+/// part of the box beyond a domain face is given to the boundary cell, so the shares sum to one.
+template <int Dim>
+struct CellOverlap {
+  static constexpr int kMaxCells = 1 << Dim;
+  int count = 0;
+  long long cell[kMaxCells][3];
+  double share[kMaxCells];
+
+  KOKKOS_INLINE_FUNCTION CellOverlap(const double x[Dim], const double l[Dim], const double origin[Dim],
+                                     const double spacing[Dim], const long long cells[Dim])
+  {
+    long long first[Dim];
+    double lower_share[Dim];
+    int span[Dim];
+    for (int d = 0; d < Dim; ++d) {
+      const double lo = (x[d] - l[d] - origin[d]) / spacing[d];
+      const double hi = (x[d] + l[d] - origin[d]) / spacing[d];
+      long long a = (long long)math::floor(lo), b = (long long)math::floor(hi);
+      a = a < 0 ? 0 : (a > cells[d] - 1 ? cells[d] - 1 : a);
+      b = b < 0 ? 0 : (b > cells[d] - 1 ? cells[d] - 1 : b);
+      first[d] = a;
+      if (b == a) {
+        span[d] = 1, lower_share[d] = 1.0;
+      } else {
+        span[d] = 2;
+        const double s = (double(a + 1) - lo) / (hi - lo);  // share below the face between a and a + 1
+        lower_share[d] = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
+      }
+    }
+    for (int corner = 0; corner < kMaxCells; ++corner) {
+      double w = 1.0;
+      bool used = true;
+      long long ijk[3] = {0, 0, 0};
+      for (int d = 0; d < Dim; ++d) {
+        const int upper = (corner >> d) & 1;
+        if (upper && span[d] == 1) used = false;
+        ijk[d] = first[d] + upper;
+        w *= upper ? 1.0 - lower_share[d] : lower_share[d];
+      }
+      if (!used) continue;
+      for (int d = 0; d < 3; ++d) cell[count][d] = ijk[d];
+      share[count++] = w;
+    }
+  }
+};
+
+}  // namespace
+
+template <int Dim>
+void MpmSolver<Dim>::particlesToCells(Field<Dim>& sums)
+{
+  if (options_.shape_function == ShapeFunction::Gimp)
+    particlesToCellsWith<UniformGimp>(sums);
+  else
+    particlesToCellsWith<LinearHat>(sums);
+}
+
+template <int Dim>
+void MpmSolver<Dim>::addCellVelocityChange(const Field<Dim>& change)
+{
+  if (options_.shape_function == ShapeFunction::Gimp)
+    addCellVelocityChangeWith<UniformGimp>(change);
+  else
+    addCellVelocityChangeWith<LinearHat>(change);
+}
+
+template <int Dim>
+template <class Kernel>
+void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums)
+{
+  const int nm = int(materials_.size());
+  if (sums.columns() != cellColumns(nm))
+    throw std::invalid_argument("MpmSolver::particlesToCells: the cell field needs " + std::to_string(cellColumns(nm)) +
+                                " columns");
+  sums.fill(0.0);
+  const Grid<Dim>& grid = layout_->grid();
+  const MaterialTable table = materialTable(materials_);
+  const auto x = particles_.position;
+  const auto mass = particles_.mass;
+  const auto volume = particles_.volume;
+  const auto half_width = particles_.half_width;
+  const auto material = particles_.material;
+  const BoxLookup nodes = layout_->nodeLookup();
+  const BoxLookup cells = layout_->cellLookup();
+  const auto node_vs = node_velocity_star_->view();
+  const auto out = sums.view();
+  double origin[Dim], spacing[Dim];
+  long long count[Dim];
+  for (int d = 0; d < Dim; ++d)
+    origin[d] = grid.lower()[d], spacing[d] = grid.spacing()[d], count[d] = grid.cells()[d];
+  const auto scatter = KOKKOS_LAMBDA(const int p)
+  {
+    const int m = material(p);
+    double xp[Dim], lp[Dim], velocity[Dim] = {};
+    for (int d = 0; d < Dim; ++d) xp[d] = x(p, d), lp[d] = half_width(p, d);
+    if (table.rigid[m]) {
+      for (int d = 0; d < Dim; ++d) velocity[d] = table.rigid_velocity[m][d];
+    } else {
+      ShapeStencil<Dim, Kernel> s;
+      evaluateShape(xp, origin, spacing, lp, s);
+      for (int k = 0; k < s.size; ++k) {
+        long long node[3] = {0, 0, 0};
+        s.node(k, node);
+        const LocalOrdinal lid = nodes(node[0], node[1], node[2]);
+        if (lid < 0) continue;
+        for (int d = 0; d < Dim; ++d) velocity[d] += s.weight[k] * node_vs(lid, m * Dim + d);
+      }
+    }
+    const CellOverlap<Dim> overlap(xp, lp, origin, spacing, count);
+    const double mp = mass(p), Vp = volume(p);
+    for (int k = 0; k < overlap.count; ++k) {
+      const LocalOrdinal c = cells(overlap.cell[k][0], overlap.cell[k][1], overlap.cell[k][2]);
+      if (c < 0) continue;  // cannot happen for a particle in an owned cell (ghost_width >= 1)
+      const double w = overlap.share[k];
+      out(c, m) += w * mp;
+      out(c, nm + m) += w * Vp;
+      for (int d = 0; d < Dim; ++d) out(c, 2 * nm + m * Dim + d) += w * mp * velocity[d];
+    }
+  };
+  // Each particle adds into the cells around its own, within the reach of its node stencil: the
+  // tile colouring of the particle-to-grid scatter keeps threads apart here too.
+  forEachParticleScattering("mpm::particles_to_cells", nodes, scatter);
+  sums.sumToOwners();
+}
+
+template <int Dim>
+template <class Kernel>
+void MpmSolver<Dim>::addCellVelocityChangeWith(const Field<Dim>& change)
+{
+  const int nm = int(materials_.size());
+  if (!node_momentum_change_)
+    node_momentum_change_ =
+        std::make_unique<Field<Dim>>(layout_, Location::Node, std::max(1, nm) * Dim, "mpm node momentum change");
+  node_momentum_change_->fill(0.0);
+  const Grid<Dim>& grid = layout_->grid();
+  const MaterialTable table = materialTable(materials_);
+  const NodeColumns col{std::max(1, nm), Dim};
+  const auto x = particles_.position;
+  const auto mass = particles_.mass;
+  const auto half_width = particles_.half_width;
+  const auto material = particles_.material;
+  const BoxLookup nodes = layout_->nodeLookup();
+  const BoxLookup cells = layout_->cellLookup();
+  const auto du = change.view();
+  const auto dmv = node_momentum_change_->view();
+  double origin[Dim], spacing[Dim];
+  long long count[Dim];
+  for (int d = 0; d < Dim; ++d)
+    origin[d] = grid.lower()[d], spacing[d] = grid.spacing()[d], count[d] = grid.cells()[d];
+  const auto scatter = KOKKOS_LAMBDA(const int p)
+  {
+    const int m = material(p);
+    if (table.rigid[m]) return;
+    double xp[Dim], lp[Dim], dv[Dim] = {};
+    for (int d = 0; d < Dim; ++d) xp[d] = x(p, d), lp[d] = half_width(p, d);
+    const CellOverlap<Dim> overlap(xp, lp, origin, spacing, count);
+    for (int k = 0; k < overlap.count; ++k) {
+      const LocalOrdinal c = cells(overlap.cell[k][0], overlap.cell[k][1], overlap.cell[k][2]);
+      if (c < 0) continue;
+      for (int d = 0; d < Dim; ++d) dv[d] += overlap.share[k] * du(c, 2 * nm + m * Dim + d);
+    }
+    ShapeStencil<Dim, Kernel> s;
+    evaluateShape(xp, origin, spacing, lp, s);
+    const double mp = mass(p);
+    for (int k = 0; k < s.size; ++k) {
+      long long node[3] = {0, 0, 0};
+      s.node(k, node);
+      const LocalOrdinal lid = nodes(node[0], node[1], node[2]);
+      if (lid < 0) continue;
+      for (int d = 0; d < Dim; ++d) dmv(lid, m * Dim + d) += s.weight[k] * mp * dv[d];
+    }
+  };
+  forEachParticleScattering("mpm::cell_velocity_change", nodes, scatter);
+  node_momentum_change_->sumToOwners();
+
+  const GridConditions<Dim> conditions = gridConditions<Dim>(*layout_, materials_, options_, empty_node_mass_, wall_no_slip_);
+  const auto sums = node_sums_->view();
+  auto velocity_star = node_velocity_star_->view();
+  const double empty = empty_node_mass_;
+  Kokkos::parallel_for(
+      "mpm::add_cell_velocity_change", Kokkos::RangePolicy<ExecutionSpace>(0, node_sums_->overlapCount()),
+      KOKKOS_LAMBDA(const int i) {
+        double vs[kMaxMaterials][Dim], m[kMaxMaterials];
+        for (int a = 0; a < nm; ++a) {
+          m[a] = sums(i, col.mass(a));
+          for (int d = 0; d < Dim; ++d) {
+            vs[a][d] = velocity_star(i, a * Dim + d);
+            if (m[a] > empty && !table.rigid[a]) vs[a][d] += dmv(i, a * Dim + d) / m[a];
+          }
+        }
+        conditions.apply(i, sums, m, vs);
+        for (int a = 0; a < nm; ++a)
+          for (int d = 0; d < Dim; ++d) velocity_star(i, a * Dim + d) = vs[a][d];
+      });
+}
+
 /// The constitutive update, last in the step (USL or MUSL), with the velocity gradient of G2P. Dispatch on
 /// the model happens once per material (SolidModel::visit); the kernel holds the concrete model.
 template <int Dim>

@@ -113,6 +113,24 @@ class MpmSolver {
   /// the ghost nodes. Phases report errors here so that the step has no extra collective.
   MigrationCounts relocateParticles();
 
+  // --- transfers of the coupled step (mpmice/): particles <-> cells ------------------------------
+  /// Columns of a cell field for particlesToCells / addCellVelocityChange: per MPM material a,
+  /// mass (column a), volume (materials + a) and momentum or velocity change (2 materials + a Dim + d).
+  static int cellColumns(int materials) { return materials * (2 + Dim); }
+  /// Each particle's mass m_p, volume V_p and momentum m_p ṽ_p into the cells that its GIMP domain
+  /// (the box of half-width l_p about it) overlaps, in proportion to the overlap (the part beyond a
+  /// domain face goes to the boundary cell), so that a body aligned with the cells fills them exactly
+  /// and the cell values change smoothly as particles cross cell faces. ṽ_p = Σ_i w_ip v*_i, the
+  /// grid velocity after integrateGrid (a rigid particle's: its prescribed velocity). Summed across
+  /// ranks: the owned cells are complete, and so are the ghosts.
+  void particlesToCells(Field<Dim>& sums);
+  /// Adds cell velocity changes Δu_c (columns 2 materials + a Dim + d; owned and ghost cells) to the
+  /// grid velocity v*: a particle takes Δv_p = Σ_c φ_pc Δu_c with the overlap shares of
+  /// particlesToCells, its momentum m_p Δv_p goes to the nodes by its weights, v*_i += Δ(mv)_i / m_i;
+  /// then contact and the walls again. The momentum given to the nodes is Σ_c m_c Δu_c exactly (m_c
+  /// the cell mass of particlesToCells). Rigid particles take no change.
+  void addCellVelocityChange(const Field<Dim>& change);
+
   /// Moves to a new decomposition of the same grid (dynamic load balancing): new node fields, and
   /// the particles go to their new owners. Collective.
   void repartition(std::shared_ptr<const Layout<Dim>> layout);
@@ -147,6 +165,10 @@ class MpmSolver {
   void particlesToGridWith();
   template <class Kernel>
   void gridToParticlesWith(double dt);
+  template <class Kernel>
+  void particlesToCellsWith(Field<Dim>& sums);
+  template <class Kernel>
+  void addCellVelocityChangeWith(const Field<Dim>& change);
   /// f(p) for every particle, for kernels that add into node arrays: in index order on one thread;
   /// on more, tile colour by tile colour (bins_, rebuilt when stale), so no two threads add into
   /// the same node.
@@ -169,6 +191,7 @@ class MpmSolver {
   std::unique_ptr<Field<Dim>> node_velocity_;       // v = p / m
   std::unique_ptr<Field<Dim>> node_velocity_star_;  // v* after forces, contact and walls
   std::unique_ptr<Field<Dim>> node_velocity_new_;   // MUSL: updated particle momenta mapped back
+  std::unique_ptr<Field<Dim>> node_momentum_change_;  // coupled step: Σ_p w_ip m_p Δv_p
   // With more than one thread, the particle-to-node scatters run tile colour by tile colour
   // (ParticleBins); the bins of P2G hold until G2P moves the particles.
   ParticleBins<Dim> bins_;

@@ -68,7 +68,17 @@ std::vector<SolidMaterial> solidMaterials(const Scene& scene)
     const int ppc = spec.parameters.isParameter("particles_per_cell") ? spec.parameters.get<int>("particles_per_cell") : 2;
     if (ppc < 1) throw inputError(path + ".particles_per_cell", std::to_string(ppc), "must be >= 1");
     if (!spec.parameters.isSublist("model")) throw InputError(path + ".model: required key is missing");
-    solids.push_back(SolidMaterial{spec.name, i, density, ppc, solidModelFromParameters(spec.parameters.sublist("model"), spec.name)});
+    const Teuchos::ParameterList& model = spec.parameters.sublist("model");
+    SolidMaterial solid{spec.name, i, density, ppc, solidModelFromParameters(model, spec.name)};
+    const std::string type = model.get<std::string>("type");
+    solid.rigid = type == "rigid";
+    if (solid.rigid)
+      solid.bulk_modulus = kRigidBulkModulus;
+    else if (type == "neo_hookean")
+      solid.bulk_modulus = number(model, "bulk_modulus", path + ".model");
+    else
+      solid.bulk_modulus = youngPoisson(model, path + ".model").bulk_modulus;
+    solids.push_back(solid);
   }
   return solids;
 }

@@ -15,7 +15,17 @@ struct SolidMaterial {
   double density = 0.0;        ///< kg/m^3 at rest
   int particles_per_cell = 2;  ///< material points per cell in each direction
   SolidModel model;            ///< constitutive model (a value type; no virtual calls)
+  /// Bulk modulus K (Pa) of the material's equation of state in the coupled step's equilibration
+  /// pressure and pressure equation: the model's elastic K, or kRigidBulkModulus for a rigid body.
+  double bulk_modulus = 0.0;
+  bool rigid = false;          ///< moves at a prescribed velocity (model type rigid)
 };
+
+/// The stiffness a rigid material is given in the coupled step's equilibration and pressure
+/// equation (it has no elastic constants of its own). Stiffer than water (2.15e9 Pa), so the share
+/// of a cut cell that the body fills barely changes with the pressure; a rigid body has no wave
+/// speed, so this stiffness never limits the time step.
+constexpr double kRigidBulkModulus = 1.0e10;
 
 /// The constitutive model described by a material's `model` sublist (keys of doc/input.md).
 SolidModel solidModelFromParameters(const Teuchos::ParameterList& model, const std::string& material_name);

@@ -1,7 +1,9 @@
 #include "mpmice/initial_state.hpp"
 
 #include "grid/geometry.hpp"
+#include "ice/material_eos.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 
@@ -24,6 +26,18 @@ int gravityAxis(const Scene& scene)
   return axis;
 }
 
+// The scene without its solid regions: the fluids that the solids displace. The initial pressure is
+// the hydrostatic pressure of these fluids (a solid's weight rests on its own stress, not on the
+// pore pressure), and they fill what the particles leave of a cell.
+Scene fluidsUnderSolids(const Scene& scene)
+{
+  Scene fluids = scene;
+  fluids.regions.clear();
+  for (const RegionSpec& r : scene.regions)
+    if (scene.materials[scene.materialIndex(r.material)].kind == "fluid") fluids.regions.push_back(r);
+  return fluids;
+}
+
 double mixtureDensity(const CellSample& cell, const std::vector<DensityOfState>& density_of, double p)
 {
   double rho = 0;
@@ -34,12 +48,29 @@ double mixtureDensity(const CellSample& cell, const std::vector<DensityOfState>&
 
 }  // namespace
 
+std::vector<DensityOfState> densityFunctions(const Scene& scene)
+{
+  std::vector<DensityOfState> result;
+  for (const MaterialSpec& material : scene.materials) {
+    if (material.kind == "fluid") {
+      const ice::Eos eos = fluidEos(material);
+      result.emplace_back([eos](double p, double T) { return eos.density(p, T); });
+    } else {
+      const double rho = material.parameters.get<double>("density");
+      result.emplace_back([rho](double, double) { return rho; });
+    }
+  }
+  return result;
+}
+
+
 template <int Dim>
 void setInitialState(const Scene& scene, const std::vector<DensityOfState>& density_of, CellState<Dim>& state)
 {
   const Layout<Dim>& layout = state.volume_fraction.layout();
   const Grid<Dim>& grid = layout.grid();
   const MaterialRegions regions(scene);
+  const MaterialRegions fluid_regions(fluidsUnderSolids(scene));
   const int axis = scene.initial.hydrostatic ? gravityAxis(scene) : -1;
 
   // Hydrostatic pressure at cell centres of a whole column, integrated from the top face (where it
@@ -61,7 +92,7 @@ void setInitialState(const Scene& scene, const std::vector<DensityOfState>& dens
       for (long long s = 0; s < n; ++s) {
         std::array<long long, 3> c = key;
         c[axis] = top_is_upper ? n - 1 - s : s;
-        const CellSample cell = regions.sampleCell(grid, c);
+        const CellSample cell = fluid_regions.sampleCell(grid, c);
         double guess = p_above, rho = 0;
         for (int pass = 0; pass < 2; ++pass) {
           rho = mixtureDensity(cell, density_of, guess);
@@ -100,6 +131,56 @@ void setInitialState(const Scene& scene, const std::vector<DensityOfState>& dens
                         &state.temperature, &state.pressure})
     f->exchangeHalo();
 }
+
+template <int Dim>
+void fillAroundSolids(const Scene& scene, const std::vector<DensityOfState>& density_of, CellState<Dim>& state)
+{
+  const Layout<Dim>& layout = state.volume_fraction.layout();
+  const Grid<Dim>& grid = layout.grid();
+  const MaterialRegions fluid_regions(fluidsUnderSolids(scene));
+  std::vector<int> fluid, solid;
+  for (int m = 0; m < state.materials; ++m) (scene.materials[m].kind == "fluid" ? fluid : solid).push_back(m);
+  auto theta = state.volume_fraction.view();
+  auto rho = state.density.view();
+  auto v = state.specific_volume.view();
+  auto u = state.velocity.view();
+  auto T = state.temperature.view();
+  const auto p = state.pressure.view();
+  const auto ijk_table = layout.cellIndex();
+  for (LocalOrdinal c = 0; c < layout.ownedCells(); ++c) {
+    double solid_share = 0, fluid_share = 0;
+    for (int m : solid) solid_share += theta(c, m);
+    for (int m : fluid) fluid_share += theta(c, m);
+    const double room = std::max(0.0, 1.0 - solid_share);
+    if (fluid_share > 0) {
+      for (int m : fluid) theta(c, m) *= room / fluid_share;
+    } else if (room > 0) {
+      // The regions gave this cell to a solid, but its particles leave room: the fluids the solid
+      // displaced fill it.
+      std::array<long long, 3> ijk{0, 0, 0};
+      for (int d = 0; d < Dim; ++d) ijk[d] = ijk_table(c, d);
+      const CellSample under = fluid_regions.sampleCell(grid, ijk);
+      double total = 0;
+      for (int m : fluid) total += under.fraction[m];
+      for (int m : fluid) {
+        theta(c, m) = total > 0 ? room * under.fraction[m] / total : 0.0;
+        T(c, m) = under.temperature[m];
+        for (int d = 0; d < Dim; ++d) u(c, CellState<Dim>::velocityColumn(m, d)) = under.velocity[m][d];
+      }
+    }
+    for (int m : fluid) {
+      const double rho_micro = density_of[m](p(c, 0), T(c, m));
+      v(c, m) = 1.0 / rho_micro;
+      rho(c, m) = theta(c, m) * rho_micro;
+    }
+  }
+  for (Field<Dim>* f : {&state.volume_fraction, &state.density, &state.specific_volume, &state.velocity,
+                        &state.temperature})
+    f->exchangeHalo();
+}
+
+template void fillAroundSolids<2>(const Scene&, const std::vector<DensityOfState>&, CellState<2>&);
+template void fillAroundSolids<3>(const Scene&, const std::vector<DensityOfState>&, CellState<3>&);
 
 template void setInitialState<2>(const Scene&, const std::vector<DensityOfState>&, CellState<2>&);
 template void setInitialState<3>(const Scene&, const std::vector<DensityOfState>&, CellState<3>&);

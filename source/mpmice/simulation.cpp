@@ -1,9 +1,7 @@
 #include "mpmice/simulation.hpp"
 
 #include "common/mpi_comm.hpp"
-#include "ice/ice_solver.hpp"
-#include "ice/material_eos.hpp"
-#include "mpm/mpm_solver.hpp"
+#include "mpmice/mpmice_step.hpp"
 #include "io/output_directory.hpp"
 #include "io/progress.hpp"
 #include "io/signals.hpp"
@@ -13,7 +11,6 @@
 
 #include <cmath>
 #include <filesystem>
-#include <functional>
 #include <iostream>
 
 namespace cfdmpm {
@@ -74,25 +71,17 @@ std::vector<double> conservedQuantities(const CellState<Dim>& state)
 }
 
 template <int Dim>
-std::vector<std::string> conservedColumns(const Scene& scene)
+std::vector<std::string> conservedColumns(const Scene& scene, bool fluids_only = false)
 {
   std::vector<std::string> columns;
   for (const auto& m : scene.materials) {
+    if (fluids_only && m.kind != "fluid") continue;
     columns.push_back("mass_" + m.name);
     for (int d = 0; d < Dim; ++d) columns.push_back(std::string("momentum_") + "xyz"[d] + "_" + m.name);
     columns.push_back("kinetic_energy_" + m.name);
   }
   return columns;
 }
-
-/// What the time loop needs of the physics of a run: its diagnostics columns and their values, the
-/// time-step limit, and one step.
-struct Physics {
-  std::vector<std::string> columns;
-  std::function<std::vector<CsvValue>()> diagnostics;
-  std::function<TimeStepLimit(double previous_dt)> limit;
-  std::function<void(double dt)> advance;
-};
 
 template <int Dim>
 RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP<const Teuchos::Comm<int>>& comm)
@@ -111,56 +100,49 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
               << grid.patchCount() << " patches on " << comm->getSize() << " rank(s)\n";
 
   // 2. The initial state from the scene's regions and the materials' equations of state, and the
-  //    solvers (their settings are checked here, before any output). Fluids run the ICE step, solids
-  //    the MPM step; a scene with both needs the coupled step, which this version does not have yet:
-  //    it stops after step 0. With `ice.enabled: false` the fluids are an inert background (a dry
-  //    scene for the particle solver alone).
+  //    coupled step with the material sets the scene has (their settings are checked here, before
+  //    any output): fluids move unless ice.enabled is false (then they are an inert background, a
+  //    dry scene for the particles alone); solids are particles.
   CellState<Dim> state(layout, int(scene.materials.size()));
   setInitialState(scene, densityFunctions(scene), state);
-  bool has_solids = false;
-  for (const auto& m : scene.materials) has_solids = has_solids || m.kind == "solid";
-  const bool fluids_move = IceSettings::fromScene(scene).enabled;
-  std::unique_ptr<IceSolver<Dim>> ice;
-  std::unique_ptr<mpm::MpmSolver<Dim>> particles;
-  IceStepReport ice_report;
-  Physics physics;
-  if (fluids_move && !has_solids) {
-    ice = std::make_unique<IceSolver<Dim>>(scene, layout);
-    const int failures = ice->equilibrate(state);
-    if (failures > 0)
-      throw std::runtime_error("initial equilibration pressure failed in " + std::to_string(failures) + " cells");
-    physics.columns = {"outer_iterations", "pressure_iterations", "outer_residual", "max_outflux_fraction"};
-    for (const std::string& c : conservedColumns<Dim>(scene)) physics.columns.push_back(c);
-    physics.diagnostics = [&] {
-      std::vector<CsvValue> row{ice_report.outer_iterations, ice_report.linear_iterations, ice_report.outer_residual,
-                                ice_report.max_outflux_fraction};
-      for (double q : conservedQuantities(state)) row.emplace_back(q);
-      return row;
-    };
-    physics.limit = [&](double previous) { return ice->stableTimeStep(state, previous); };
-    physics.advance = [&](double dt) { ice_report = ice->step(state, dt); };
-  } else if (!fluids_move && has_solids) {
-    particles = std::make_unique<mpm::MpmSolver<Dim>>(scene, layout, mpm::optionsFromScene(scene));
-    physics.columns = {"particles"};
+  MpmIceStep<Dim> stepper(scene, layout, state);
+  CoupledStepReport step_report;
+  const bool moves = stepper.fluidsMove() || stepper.hasParticles();
+  std::vector<std::string> physics_columns;
+  if (stepper.fluidsMove()) {
+    physics_columns = {"outer_iterations", "pressure_iterations", "outer_residual", "max_outflux_fraction"};
+    // With particles, the solids' columns are theirs (exact masses), not the cells'.
+    for (const std::string& c : conservedColumns<Dim>(scene, stepper.hasParticles())) physics_columns.push_back(c);
+    physics_columns.insert(physics_columns.end(), {"equilibration_failures", "exchange_failures", "pressure_converged"});
+  }
+  if (stepper.hasParticles()) {
+    physics_columns.push_back("particles");
     for (const auto& m : scene.materials)
-      if (m.kind == "solid") physics.columns.push_back("mass_" + m.name);
-    for (int d = 0; d < Dim; ++d) physics.columns.push_back(std::string("momentum_") + "xyz"[d] + "_particles");
-    physics.columns.push_back("kinetic_energy_particles");
-    physics.diagnostics = [&] {
-      std::vector<CsvValue> row{particles->particleCount()};
+      if (m.kind == "solid") physics_columns.push_back("mass_" + m.name);
+    for (int d = 0; d < Dim; ++d) physics_columns.push_back(std::string("momentum_") + "xyz"[d] + "_particles");
+    physics_columns.push_back("kinetic_energy_particles");
+  }
+  auto physicsRow = [&] {
+    std::vector<CsvValue> row;
+    if (stepper.fluidsMove()) {
+      const IceStepReport& r = step_report.ice;
+      row = {r.outer_iterations, r.linear_iterations, r.outer_residual, r.max_outflux_fraction};
+      const std::vector<double> sums = conservedQuantities(state);
+      for (int m = 0; m < state.materials; ++m)
+        if (!stepper.hasParticles() || scene.materials[m].kind == "fluid")
+          for (int k = 0; k < Dim + 2; ++k) row.emplace_back(sums[m * (Dim + 2) + k]);
+      row.insert(row.end(), {CsvValue(r.equilibration_failures), CsvValue(r.exchange_failures),
+                             CsvValue(r.converged ? 1 : 0)});
+    }
+    if (const mpm::MpmSolver<Dim>* particles = stepper.particles()) {
+      row.emplace_back(particles->particleCount());
       for (double m : particles->materialMasses()) row.emplace_back(m);
       const auto p = particles->momentum();
       for (int d = 0; d < Dim; ++d) row.emplace_back(p[d]);
       row.emplace_back(particles->kineticEnergy());
-      return row;
-    };
-    physics.limit = [&](double) {
-      const mpm::MpmTimeStep mpm_limit = particles->stableTimeStep();
-      if (!(mpm_limit.dt < scene.time.dt_max)) return TimeStepLimit{scene.time.dt_max, "dt_max"};
-      return TimeStepLimit{mpm_limit.dt, "wave_speed(" + mpm_limit.material + ")"};
-    };
-    physics.advance = [&](double dt) { particles->step(dt); };
-  }
+    }
+    return row;
+  };
 
   // 3. Output: the directory (refused if it holds an earlier run, unless overwrite), the fields of
   //    step 0, and the diagnostics time series.
@@ -169,16 +151,16 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
   const std::string run_name = std::filesystem::path(scene.path).stem().string();
   StateOutput<Dim> output(scene, *layout, run_name);
   std::vector<std::string> columns{"step", "time", "dt", "dt_limiter"};
-  if (physics.advance)
-    columns.insert(columns.end(), physics.columns.begin(), physics.columns.end());
+  if (moves)
+    columns.insert(columns.end(), physics_columns.begin(), physics_columns.end());
   else
     for (const std::string& c : conservedColumns<Dim>(scene)) columns.push_back(c);
   const std::string csv_path = scene.output.directory + "/" + run_name + ".csv";
   CsvTimeSeries diagnostics(mpi, csv_path, columns);
   auto report = [&](long long step, double time, double dt, const std::string& limiter) {
     std::vector<CsvValue> row{step, time, dt, limiter};
-    if (physics.advance) {
-      for (CsvValue& v : physics.diagnostics()) row.push_back(v);
+    if (moves) {
+      for (CsvValue& v : physicsRow()) row.push_back(v);
     } else {
       for (double q : conservedQuantities(state)) row.emplace_back(q);
     }
@@ -190,19 +172,16 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
   summary.output_directory = scene.output.directory;
   summary.diagnostics = csv_path;
   auto writeOutput = [&](long long step, double time) {
-    if (!particles) return output.write(step, time, state);
-    const mpm::ParticleOutput out = particles->output();
+    if (!stepper.particles()) return output.write(step, time, state);
+    const mpm::ParticleOutput out = stepper.particles()->output();
     return output.write(step, time, state, &out);
   };
   const std::string first = writeOutput(0, 0.0);
   report(0, 0.0, 0.0, "initial");
   if (root) std::cout << "  wrote initial state: " << first << "\n";
   summary.time_series = output.seriesPath();
-  if (!physics.advance) {
-    if (root)
-      std::cout << (has_solids ? "  the scene has fluids and solids; the coupled step is not in this version "
-                                 "(set ice.enabled: false to run the solids alone): stopping after the initial state\n"
-                               : "  ice.enabled is false and the scene has no solids: nothing moves; stopping\n");
+  if (!moves) {
+    if (root) std::cout << "  ice.enabled is false and the scene has no solids: nothing moves; stopping\n";
     return summary;
   }
 
@@ -212,10 +191,11 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
   double next_output = interval > 0 ? interval : end;
   double t = 0, dt_previous = 0;
   long long step = 0;
+  int unconverged_warnings = 0;
   ProgressReporter progress(mpi, 0.0, end, scene.output.progress_interval);
   const double eps = 1e-12 * end;
   while (t < end - eps && (scene.time.max_steps < 0 || step < scene.time.max_steps)) {
-    TimeStepLimit limit = physics.limit(dt_previous);
+    TimeStepLimit limit = stepper.stableTimeStep(state, dt_previous);
     if (step == 0 && scene.time.dt_initial < limit.dt) limit = {scene.time.dt_initial, "dt_initial"};
     dt_previous = limit.dt;
     double dt = limit.dt;
@@ -223,7 +203,14 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
       dt = next_output - t;
       limit.limiter += "+output";
     }
-    physics.advance(dt);
+    step_report = stepper.step(state, dt);
+    if (stepper.fluidsMove() && !step_report.ice.converged && root && ++unconverged_warnings <= 10)
+      std::cout << "  warning: step " << step + 1 << ": the pressure's outer iteration stopped at residual "
+                << step_report.ice.outer_residual << " after " << step_report.ice.outer_iterations
+                << " iterations (ice.outer_tolerance " << IceSettings::fromScene(scene).outer_tolerance
+                << ", ice.max_outer_iterations " << IceSettings::fromScene(scene).max_outer_iterations
+                << "); column pressure_converged of the CSV marks such steps"
+                << (unconverged_warnings == 10 ? " (further warnings suppressed)" : "") << "\n";
     t = (t + dt > next_output - eps) ? next_output : t + dt;
     ++step;
     report(step, t, dt, limit.limiter);

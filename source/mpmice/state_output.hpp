@@ -5,7 +5,7 @@
 #include "io/hdf5_writer.hpp"
 #include "io/xdmf_writer.hpp"
 #include "mpm/mpm_solver.hpp"
-#include "mpmice/cell_state.hpp"
+#include "fields/cell_state.hpp"
 
 #include <memory>
 #include <string>

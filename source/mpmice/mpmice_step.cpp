@@ -1,0 +1,188 @@
+#include "mpmice/mpmice_step.hpp"
+
+#include "mpmice/initial_state.hpp"
+
+#include <Teuchos_TimeMonitor.hpp>
+
+#include <sstream>
+#include <stdexcept>
+
+namespace cfdmpm {
+
+namespace {
+
+bool hasSolids(const Scene& scene)
+{
+  for (const MaterialSpec& m : scene.materials)
+    if (m.kind == "solid") return true;
+  return false;
+}
+
+}  // namespace
+
+template <int Dim>
+MpmIceStep<Dim>::MpmIceStep(const Scene& scene, std::shared_ptr<const Layout<Dim>> layout, CellState<Dim>& state)
+    : scene_(scene), layout_(std::move(layout))
+{
+  for (const char* phase : kPhases) timers_[phase] = Teuchos::TimeMonitor::getNewCounter(std::string("mpmice: ") + phase);
+  if (hasSolids(scene)) mpm_ = std::make_unique<mpm::MpmSolver<Dim>>(scene, layout_, mpm::optionsFromScene(scene));
+  if (IceSettings::fromScene(scene).enabled) {
+    std::vector<SolidProperties> solids;
+    if (mpm_)
+      for (const mpm::SolidMaterial& s : mpm_->materials())
+        solids.push_back(SolidProperties{s.scene_index, s.bulk_modulus, s.density, s.rigid});
+    ice_ = std::make_unique<IceSolver<Dim>>(scene, layout_, solids);
+  }
+  if (ice_ && mpm_) {
+    // The solids' share of every cell is that of their particles' GIMP domains; the fluids fill the
+    // rest, so that the first equilibration starts from full cells.
+    const int columns = mpm::MpmSolver<Dim>::cellColumns(int(mpm_->materials().size()));
+    cell_sums_ = std::make_unique<Field<Dim>>(layout_, Location::Cell, columns, "solid cell sums");
+    cell_change_ = std::make_unique<Field<Dim>>(layout_, Location::Cell, columns, "solid velocity change");
+    solid_velocity_ = std::make_unique<Field<Dim>>(layout_, Location::Cell, int(mpm_->materials().size()) * Dim,
+                                                   "solid cell velocity");
+    mpm_->particlesToGrid();
+    mpm_->integrateGrid(0.0);  // v* = v: the particles' velocities on the grid, walls applied
+    cellsFromParticles(state);
+    fillAroundSolids(scene, densityFunctions(scene), state);
+  }
+  if (ice_) {
+    const int failures = ice_->equilibrate(state);
+    if (failures > 0)
+      throw std::runtime_error("initial equilibration pressure failed in " + std::to_string(failures) + " cells");
+  }
+}
+
+template <int Dim>
+MpmIceStep<Dim>::~MpmIceStep() = default;
+
+template <int Dim>
+CoupledStepReport MpmIceStep<Dim>::step(CellState<Dim>& state, double dt)
+{
+  CoupledStepReport report;
+  Teuchos::TimeMonitor whole(*timers_.at("step"));
+
+  // 1. Particles to nodes: mass, momentum, the skeleton stress's force and gravity; v* with contact
+  //    between solids and the walls.
+  if (mpm_) {
+    Teuchos::TimeMonitor phase(*timers_.at("1 particles to grid"));
+    mpm_->particlesToGrid();
+    mpm_->integrateGrid(dt);
+  }
+  // 2. The solids' mass, volume and velocity v* in every cell.
+  if (ice_ && mpm_) {
+    Teuchos::TimeMonitor phase(*timers_.at("2 particles to cells"));
+    cellsFromParticles(state);
+  }
+  if (ice_) {
+    // 3-6. Equilibration pressure, face velocities and face exchange, implicit pressure, momentum
+    //      sources: every material, solids included.
+    {
+      Teuchos::TimeMonitor phase(*timers_.at("3-6 fluid pressure"));
+      ice_->equilibrationPhase(state, report.ice);
+      ice_->faceVelocityPhase(state, dt);
+      ice_->pressurePhase(state, dt, report.ice);
+      ice_->momentumSourcePhase(state, dt);
+    }
+    // 8. Cell-centred exchange between all materials.
+    {
+      Teuchos::TimeMonitor phase(*timers_.at("8 exchange"));
+      ice_->exchangePhase(state, dt, report.ice);
+    }
+    if (report.ice.exchange_failures > 0) {
+      const long long cell = report.ice.first_failed_cell;
+      std::ostringstream message;
+      message << "coupled step: the momentum exchange gave values that are not finite in " << report.ice.exchange_failures
+              << " cell(s), the first at cell " << cell << " (i = " << cell % layout_->grid().cells()[0]
+              << ", j = " << (cell / layout_->grid().cells()[0]) % layout_->grid().cells()[1]
+              << "); a material's density, volume fraction or velocity there is not finite (reduce the time step "
+                 "or check the materials' parameters)";
+      throw std::runtime_error(message.str());
+    }
+  }
+  // 9. The solids' velocity change from the pressure force and the exchange back to the nodes;
+  //    grid to particles; stress update; particles to their ranks.
+  if (mpm_) {
+    Teuchos::TimeMonitor phase(*timers_.at("9 grid to particles"));
+    if (ice_) {
+      velocityChange(state);
+      mpm_->addCellVelocityChange(*cell_change_);
+    }
+    mpm_->gridToParticles(dt);
+    mpm_->updateStress(dt);
+    mpm_->relocateParticles();
+  }
+  // 10. Advection of the fluids.
+  if (ice_) {
+    Teuchos::TimeMonitor phase(*timers_.at("10 advection"));
+    ice_->advectionPhase(state, dt, report.ice);
+  }
+  return report;
+}
+
+template <int Dim>
+void MpmIceStep<Dim>::cellsFromParticles(CellState<Dim>& state)
+{
+  mpm_->particlesToCells(*cell_sums_);
+  const int nm = int(mpm_->materials().size());
+  Kokkos::Array<int, ice::kMaxMaterials> scene_index{};
+  for (int a = 0; a < nm; ++a) scene_index[a] = mpm_->materials()[a].scene_index;
+  const double volume = layout_->grid().cellVolume();
+  const auto sums = cell_sums_->view();
+  auto rho = state.density.view();
+  auto theta = state.volume_fraction.view();
+  auto u = state.velocity.view();
+  auto solid_u = solid_velocity_->view();
+  // The sums are complete on the ghosts as well, so every local cell is set without a halo exchange.
+  Kokkos::parallel_for(
+      "mpmice::cellsFromParticles", Kokkos::RangePolicy<ExecutionSpace>(0, state.density.overlapCount()),
+      KOKKOS_LAMBDA(const LocalOrdinal c) {
+        for (int a = 0; a < nm; ++a) {
+          const int m = scene_index[a];
+          const double mass = sums(c, a);
+          rho(c, m) = mass / volume;
+          theta(c, m) = sums(c, nm + a) / volume;
+          for (int d = 0; d < Dim; ++d) {
+            const double velocity = mass > 0 ? sums(c, 2 * nm + a * Dim + d) / mass : 0.0;
+            u(c, m * Dim + d) = velocity;
+            solid_u(c, a * Dim + d) = velocity;
+          }
+        }
+      });
+}
+
+template <int Dim>
+void MpmIceStep<Dim>::velocityChange(const CellState<Dim>& state)
+{
+  const int nm = int(mpm_->materials().size());
+  Kokkos::Array<int, ice::kMaxMaterials> scene_index{};
+  for (int a = 0; a < nm; ++a) scene_index[a] = mpm_->materials()[a].scene_index;
+  const auto u = state.velocity.view();
+  const auto solid_u = solid_velocity_->view();
+  auto change = cell_change_->view();
+  Kokkos::parallel_for(
+      "mpmice::velocityChange", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+      KOKKOS_LAMBDA(const LocalOrdinal c) {
+        for (int a = 0; a < nm; ++a)
+          for (int d = 0; d < Dim; ++d)
+            change(c, 2 * nm + a * Dim + d) = u(c, scene_index[a] * Dim + d) - solid_u(c, a * Dim + d);
+      });
+  cell_change_->exchangeHalo();  // particles in owned cells reach into ghost cells
+}
+
+template <int Dim>
+TimeStepLimit MpmIceStep<Dim>::stableTimeStep(const CellState<Dim>& state, double previous_dt) const
+{
+  TimeStepLimit limit{scene_.time.dt_max, "dt_max"};
+  if (ice_) limit = ice_->stableTimeStep(state, previous_dt);
+  if (mpm_) {
+    const mpm::MpmTimeStep particles = mpm_->stableTimeStep();
+    if (particles.dt < limit.dt) limit = {particles.dt, "wave_speed(" + particles.material + ")"};
+  }
+  return limit;
+}
+
+template class MpmIceStep<2>;
+template class MpmIceStep<3>;
+
+}  // namespace cfdmpm

@@ -1,0 +1,85 @@
+#pragma once
+// One time step of the coupled method (MPMICE, in the order of Uintah's MPMICE step; design.md,
+// "One time step"): fluids (ICE) and solids (MPM) on one grid, one pressure, one exchange.
+//
+//    1. MPM: particles to grid nodes; the solids' stress and gravity, contact, walls: v*
+//    2. particles to cells: the solids' mass, volume and velocity v* in every cell
+//    3. equilibration pressure of all materials
+//    4. face velocities of all materials and the implicit face exchange
+//    5. implicit pressure with outer iterations
+//    6. momentum sources: pressure force on every material; viscosity and gravity on fluids
+//    7. (the pressure needs no separate way to the particles: it reaches the solids as the pressure
+//       force of step 6, and their particle stress is the skeleton's, without the fluid pressure)
+//    8. implicit cell-centred exchange between all materials
+//    9. the solids' velocity change of steps 6 and 8 back to the nodes; grid to particles; stress
+//   10. advection of the fluids (solids are Lagrangian)
+//   11. the next Δt (stableTimeStep): the smaller of the fluid and the particle limits
+//
+// A scene without solids runs steps 3-6, 8 and 10; a dry scene (ice.enabled false) steps 1 and 9:
+// the same step with one material set empty.
+#include "fields/cell_state.hpp"
+#include "ice/ice_solver.hpp"
+#include "mpm/mpm_solver.hpp"
+
+#include <Teuchos_Time.hpp>
+
+#include <map>
+#include <memory>
+#include <string>
+
+namespace cfdmpm {
+
+/// What a coupled step did (the ICE part is zero when the fluids do not move).
+struct CoupledStepReport {
+  IceStepReport ice;
+};
+
+template <int Dim>
+class MpmIceStep {
+ public:
+  /// Builds the solvers the scene needs (fluids move unless ice.enabled is false; particles when it
+  /// has solids) and, when both are present, makes the state's solid columns those of the particles
+  /// and lets the fluids fill the rest of each cell. The state holds the initial state on entry.
+  MpmIceStep(const Scene& scene, std::shared_ptr<const Layout<Dim>> layout, CellState<Dim>& state);
+  ~MpmIceStep();
+
+  /// One step of length dt (collective). Throws std::runtime_error (on every rank) naming what
+  /// failed.
+  CoupledStepReport step(CellState<Dim>& state, double dt);
+
+  /// [11] The largest stable Δt: the fluid step's limits and the particles' wave speed, the
+  /// smallest named in the limiter (e.g. "convection(water)", "wave_speed(sand)").
+  TimeStepLimit stableTimeStep(const CellState<Dim>& state, double previous_dt) const;
+
+  bool fluidsMove() const { return bool(ice_); }
+  bool hasParticles() const { return bool(mpm_); }
+  IceSolver<Dim>* fluids() { return ice_.get(); }
+  mpm::MpmSolver<Dim>* particles() { return mpm_.get(); }
+  const mpm::MpmSolver<Dim>* particles() const { return mpm_.get(); }
+
+  /// The phases, timed by Teuchos timers named "mpmice: <phase>" ("step" is the whole step).
+  static constexpr const char* kPhases[] = {"step",     "1 particles to grid", "2 particles to cells",
+                                            "3-6 fluid pressure", "8 exchange", "9 grid to particles",
+                                            "10 advection"};
+  double phaseSeconds(const std::string& phase) const { return timers_.at(phase)->totalElapsedTime(); }
+
+ private:
+  /// The solids' columns of the state (mass density, volume fraction, velocity) from the particles.
+  void cellsFromParticles(CellState<Dim>& state);
+  /// The solids' cell velocity change since cellsFromParticles, in the particle solver's columns.
+  void velocityChange(const CellState<Dim>& state);
+
+  Scene scene_;
+  std::shared_ptr<const Layout<Dim>> layout_;
+  std::unique_ptr<IceSolver<Dim>> ice_;
+  std::unique_ptr<mpm::MpmSolver<Dim>> mpm_;
+  std::unique_ptr<Field<Dim>> cell_sums_;       // particlesToCells: mass, volume, momentum per solid
+  std::unique_ptr<Field<Dim>> cell_change_;     // velocity change of the solids' cells (same columns)
+  std::unique_ptr<Field<Dim>> solid_velocity_;  // the solids' cell velocity from the particles
+  std::map<std::string, Teuchos::RCP<Teuchos::Time>> timers_;
+};
+
+extern template class MpmIceStep<2>;
+extern template class MpmIceStep<3>;
+
+}  // namespace cfdmpm

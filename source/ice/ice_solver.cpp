@@ -55,12 +55,16 @@ constexpr double kRigidInertia = 1e30;
 // The exchange coefficients between every pair: the scene's K between fluids and between a fluid
 // and a solid; zero between two solids (MPM's contact acts between them, with friction and free
 // separation; a drag would make a sliding body stick to the bed).
-ice::ExchangeCoefficients pairCoefficients(double coefficient, int materials, const MaterialRoles& roles)
+// On faces a rigid body takes no part in the exchange: it closes the share of the face it covers
+// instead (faceVelocities), so that fluid still flows through the open part of a cut cell's face.
+ice::ExchangeCoefficients pairCoefficients(double coefficient, int materials, const MaterialRoles& roles,
+                                           bool on_faces = false)
 {
   ice::ExchangeCoefficients K = ice::ExchangeCoefficients::uniform(coefficient);
   for (int m = 0; m < materials; ++m)
     for (int n = 0; n < materials; ++n)
-      if (m != n && roles.lagrangian[m] && roles.lagrangian[n]) K.set(m, n, 0.0);
+      if (m != n && ((roles.lagrangian[m] && roles.lagrangian[n]) || (on_faces && (roles.rigid[m] || roles.rigid[n]))))
+        K.set(m, n, 0.0);
   return K;
 }
 
@@ -127,8 +131,10 @@ IceSolver<Dim>::IceSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>>
       face_specific_volume_(layout, materials_, "face_specific_volume"),
       face_beta_(layout, 1, "face_beta"),
       new_velocity_(layout, Location::Cell, materials_ * Dim, "new_velocity"),
-      old_specific_volume_(layout, Location::Cell, materials_, "old_specific_volume")
+      old_specific_volume_(layout, Location::Cell, materials_, "old_specific_volume"),
+      solid_reference_pressure_(layout, Location::Cell, 1, "solid_reference_pressure")
 {
+  solid_reference_pressure_.fill(scene.initial.pressure);
   if (materials_ > ice::kMaxMaterials)
     throw InputError("cfdmpm.materials: " + std::to_string(materials_) + " materials; at most " +
                      std::to_string(ice::kMaxMaterials) + " are allowed");
@@ -178,12 +184,20 @@ IceSolver<Dim>::IceSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>>
 template <int Dim>
 IceSolver<Dim>::~IceSolver() = default;
 
+template <int Dim>
+void IceSolver<Dim>::setSolidReferencePressure(const Field<Dim>& pressure)
+{
+  Kokkos::deep_copy(solid_reference_pressure_.view(), pressure.view());
+}
+
 // [3] Equilibration pressure: per cell, the pressure at which the materials' volumes fill it.
-// A solid's equation of state is taken about its state in the cell: its cell volume fraction on
-// entry (from the particles' volumes) at the cell's pressure on entry, with the stiffness of its bulk
-// modulus, ρ_micro(p) = (ρ_s/θ_s) / (1 − (p − p_old)/K). A cell that the solid fills alone keeps its
-// pressure (the pore pressure that the pressure equation carries), and the solid's share of a mixed
-// cell changes only by what the pressure change compresses it.
+// A solid's equation of state is taken about its share of the cell on entry (θ_s from the particles'
+// volumes) at the cell's reference pressure p_ref (solidReferencePressure: the fluids' hydrostatic
+// pressure of the initial state), with the stiffness of its bulk modulus:
+// ρ_micro(p) = (ρ_s/θ_s) / (1 − (p − p_ref)/K). A cell that a solid fills alone then has the pore
+// pressure of still fluid at its place, and a solid that the particles pack into more (or less)
+// than its cell pushes with K times the excess. (The pressure of the previous step in place of p_ref
+// would integrate a persistent excess from step to step without bound.)
 template <int Dim>
 int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
 {
@@ -198,6 +212,7 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
   auto p = state.pressure.view();
   auto kappa = compressibility_.view();
   auto sum_kappa = mixture_compressibility_.view();
+  const auto p_ref = solid_reference_pressure_.view();
   int failures = 0;
   const auto kernel = [&](auto count, auto with_solids) {
     constexpr int N = decltype(count)::value;
@@ -213,10 +228,17 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
           }
           ice::EquilibrationResult r;
           if constexpr (kSolids) {
+            // A trace of a material (less than kNegligibleMassShare of the cell's mass: e.g. air
+            // advected to a denormal density into a cell that sand and water fill) cannot fill the
+            // room that the others leave; it takes no part in the root (it would drive p to 0).
+            double cell_mass = 0;
+            for (int m = 0; m < nm; ++m) cell_mass += mass_density[m];
+            for (int m = 0; m < nm; ++m)
+              if (!(mass_density[m] > kNegligibleMassShare * cell_mass)) mass_density[m] = 0.0;
             ice::MaterialArray<ice::Eos> local = eos;
             for (int m = 0; m < nm; ++m)
               if (roles.lagrangian[m] && mass_density[m] > 0 && theta(c, m) > 0)
-                local[m] = ice::SolidEos(bulk[m], mass_density[m] / theta(c, m), p(c, 0));
+                local[m] = ice::SolidEos(bulk[m], mass_density[m] / theta(c, m), p_ref(c, 0));
             r = ice::equilibrationPressure<N>(nm, local, mass_density, temperature, p(c, 0));
           } else {
             r = ice::equilibrationPressure<N>(nm, eos, mass_density, temperature, p(c, 0));
@@ -226,9 +248,11 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
           double sk = 0;
           for (int m = 0; m < nm; ++m) {
             theta(c, m) = r.volume_fraction[m];
-            v(c, m) = 1.0 / r.density[m];
-            kappa(c, m) = r.compressibility[m];
-            sk += r.volume_fraction[m] * r.compressibility[m];
+            // A material without mass keeps its specific volume where the cell's pressure lies
+            // outside what its equation of state can represent (a solid squeezed beyond p_ref + K).
+            if (mass_density[m] > 0 || (r.density[m] > 0 && r.density[m] < DBL_MAX)) v(c, m) = 1.0 / r.density[m];
+            kappa(c, m) = r.compressibility[m] > 0 && r.compressibility[m] < DBL_MAX ? r.compressibility[m] : 0.0;
+            sk += r.volume_fraction[m] * kappa(c, m);
           }
           sum_kappa(c, 0) = sk;
         },
@@ -261,7 +285,7 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
   const auto theta = state.volume_fraction.view();
   const auto v = state.specific_volume.view();
   const auto p = state.pressure.view();
-  const auto K = pairCoefficients(settings_.exchange_coefficient, n, roles_);
+  const auto K = pairCoefficients(settings_.exchange_coefficient, n, roles_, true);
   const auto roles = roles_;
   forMaterialCount(n, [&](auto count) {
     constexpr int N = decltype(count)::value;
@@ -294,7 +318,6 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
               vel[m] = roles.rigid[m]        ? mean
                        : roles.lagrangian[m] ? mean - dt_per_h * vbar * pressure_difference
                                              : mean - dt_per_h * vbar * pressure_difference + dt * g;
-              if (roles.rigid[m]) vl[m] /= kRigidInertia, vr[m] /= kRigidInertia;
             }
             ice::exchangeMomentumFC<N>(nm, dt, K, tl, tr, vl, vr, vel, sv);
             // A material absent on both sides has no weight in the exchange and would keep its own
@@ -302,18 +325,30 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
             // instead, whose specific volume is β = Σ θ_f v_f (Σ θ_f = 1).
             double b = 0, weight = 0, momentum = 0;
             for (int m = 0; m < nm; ++m) {
+              if (roles.rigid[m]) continue;
               const double w = (tl[m] + tr[m]) / sv[m];
               weight += w;
               momentum += w * vel[m];
               b += 0.5 * (tl[m] + tr[m]) * sv[m];
             }
+            // A rigid body covers the share of the face that its larger share of the two cells
+            // gives; the other materials flow through the rest (a cell it fills is a wall). It
+            // keeps its own face velocity and takes no pressure correction.
+            double closed = 0;
+            for (int m = 0; m < nm; ++m)
+              if (roles.rigid[m]) closed += Kokkos::Experimental::fmax(tl[m], tr[m]);
+            const double open = closed < 1.0 ? 1.0 - closed : 0.0;
             const double mixture = momentum / (weight + kTiny);
             for (int m = 0; m < nm; ++m) {
+              if (roles.rigid[m]) {
+                uf(c, m) = vel[m], vf(c, m) = 0.0;
+                continue;
+              }
               const bool present = tl[m] + tr[m] > 2 * kNegligibleVolumeShare;
-              uf(c, m) = present ? vel[m] : mixture;
-              vf(c, m) = present ? sv[m] : b;  // and follows the mixture's pressure correction
+              uf(c, m) = open * (present ? vel[m] : mixture);
+              vf(c, m) = open * (present ? sv[m] : b);  // and follows the mixture's pressure correction
             }
-            beta(c, 0) = b;
+            beta(c, 0) = open * b;
           });
     }
   });
@@ -434,6 +469,7 @@ void IceSolver<Dim>::momentumSourcePhase(CellState<Dim>& state, double dt)
   auto v = state.specific_volume.view();
   const auto mu = viscosity_;
   const auto roles = roles_;
+  const bool with_solids = roles_.any_solid;
   double h[3], inverse_h2[3], g[3];
   int no_slip[6];
   for (int d = 0; d < Dim; ++d) {
@@ -453,28 +489,57 @@ void IceSolver<Dim>::momentumSourcePhase(CellState<Dim>& state, double dt)
           for (int f = 0; f < 2 * Dim; ++f) neighbour[f] = neighbours(c, f);
           ice::MaterialArray<double> r{}, t{};
           for (int m = 0; m < nm; ++m) r[m] = rho(c, m), t[m] = theta(c, m);
-          // The fluids' density sets the hydrostatic pressure profile (a solid's weight rests on
-          // its own stress, not on the pore pressure).
-          double sum_rho_c = 0;
-          for (int m = 0; m < nm; ++m) sum_rho_c += roles.lagrangian[m] ? 0.0 : r[m];
           double grad_p[3] = {0, 0, 0};
-          for (int d = 0; d < Dim; ++d) {
-            double face_p[2];
-            for (int side = 0; side < 2; ++side) {
-              const LocalOrdinal o = neighbour[2 * d + side];
-              if (o < 0) {
-                // Wall: the pressure's normal gradient is the hydrostatic one (dp/dn = ρ g·n), so a
-                // fluid at rest next to a wall feels no net force.
-                face_p[side] = p(c, 0) + (side == 0 ? -0.5 : 0.5) * h[d] * sum_rho_c * g[d];
-                continue;
+          if (!with_solids) {
+            double sum_rho_c = 0;
+            for (int m = 0; m < nm; ++m) sum_rho_c += r[m];
+            for (int d = 0; d < Dim; ++d) {
+              double face_p[2];
+              for (int side = 0; side < 2; ++side) {
+                const LocalOrdinal o = neighbour[2 * d + side];
+                if (o < 0) {
+                  // Wall: the pressure's normal gradient is the hydrostatic one (dp/dn = ρ g·n), so
+                  // a fluid at rest next to a wall feels no net force.
+                  face_p[side] = p(c, 0) + (side == 0 ? -0.5 : 0.5) * h[d] * sum_rho_c * g[d];
+                  continue;
+                }
+                double sum_rho_o = 0;
+                for (int m = 0; m < nm; ++m) sum_rho_o += rho(o, m);
+                face_p[side] = (p(o, 0) * sum_rho_c + p(c, 0) * sum_rho_o) / (sum_rho_c + sum_rho_o + kTiny);
               }
-              double sum_rho_o = 0;
-              for (int m = 0; m < nm; ++m) sum_rho_o += roles.lagrangian[m] ? 0.0 : rho(o, m);
-              face_p[side] = sum_rho_c + sum_rho_o > 0
-                                 ? (p(o, 0) * sum_rho_c + p(c, 0) * sum_rho_o) / (sum_rho_c + sum_rho_o + kTiny)
-                                 : 0.5 * (p(o, 0) + p(c, 0));  // two cells of solids alone
+              grad_p[d] = (face_p[1] - face_p[0]) / h[d];
             }
-            grad_p[d] = (face_p[1] - face_p[0]) / h[d];
+          } else {
+            // With solids the pressure is the pore fluid's: its profile follows the density of the
+            // fluids per volume of fluid (a solid's weight rests on its own stress). Between two
+            // cells that hold fluid the face pressure is weighted by these densities as above; where
+            // a cell holds no fluid (a solid alone) the pressure is interpolated linearly (a
+            // central difference), and extrapolated linearly to a wall.
+            const auto fluidDensity = [&](LocalOrdinal cell) {
+              double mass = 0, volume = 0;
+              for (int m = 0; m < nm; ++m)
+                if (!roles.lagrangian[m]) mass += rho(cell, m), volume += theta(cell, m);
+              return mass > 0 && volume > 0 ? mass / volume : 0.0;
+            };
+            const double rho_c = fluidDensity(c);
+            for (int d = 0; d < Dim; ++d) {
+              double face_p[2];
+              bool extrapolate[2] = {false, false};
+              for (int side = 0; side < 2; ++side) {
+                const LocalOrdinal o = neighbour[2 * d + side];
+                if (o < 0) {
+                  face_p[side] = p(c, 0) + (side == 0 ? -0.5 : 0.5) * h[d] * rho_c * g[d];
+                  extrapolate[side] = !(rho_c > 0);
+                  continue;
+                }
+                const double rho_o = fluidDensity(o);
+                face_p[side] = rho_c > 0 && rho_o > 0 ? (p(o, 0) * rho_c + p(c, 0) * rho_o) / (rho_c + rho_o)
+                                                      : 0.5 * (p(o, 0) + p(c, 0));
+              }
+              if (extrapolate[0] && !extrapolate[1]) face_p[0] = 2.0 * p(c, 0) - face_p[1];
+              if (extrapolate[1] && !extrapolate[0]) face_p[1] = 2.0 * p(c, 0) - face_p[0];
+              grad_p[d] = (face_p[1] - face_p[0]) / h[d];
+            }
           }
           for (int m = 0; m < nm; ++m) {
             for (int k = 0; k < Dim; ++k) {

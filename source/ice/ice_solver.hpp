@@ -121,6 +121,10 @@ class IceSolver {
   /// momentumSourcePhase and exchangePhase; afterwards work space).
   const Field<Dim>& lagrangianVelocity() const { return new_velocity_; }
   const MaterialRoles& roles() const { return roles_; }
+  /// The pressure about which the solids' equation of state is taken in each cell (the pore pressure
+  /// of still fluid there; default: initial_state.pressure everywhere). The coupled step sets it to
+  /// the initial state's pressure, the hydrostatic pressure of the fluids that the solids displace.
+  void setSolidReferencePressure(const Field<Dim>& pressure);
 
   /// The largest stable Δt for the state (convective CFL and viscous limits), at most
   /// growth × previous_dt and within [dt_min, dt_max].
@@ -168,6 +172,7 @@ class IceSolver {
   FaceField<Dim> face_beta_;            // Σ θ_f v_f
   Field<Dim> new_velocity_;             // Lagrangian velocities between sources and exchange
   Field<Dim> old_specific_volume_;      // v before the Lagrangian update (for the p dv work)
+  Field<Dim> solid_reference_pressure_; // p_ref of the solids' equation of state per cell (Pa)
   std::unique_ptr<PressureSolver<Dim>> pressure_solver_;
   std::unique_ptr<Advector<Dim>> advector_;
   std::map<std::string, Teuchos::RCP<Teuchos::Time>> timers_;

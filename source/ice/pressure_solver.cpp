@@ -492,7 +492,14 @@ void PressureSolver<Dim>::assemble(const Field<Dim>& mixture_compressibility, Fa
     if (local_bad) {
       const auto ijk = lay.grid().cellIndex(lay.ownedCellMap()->getGlobalElement(first_bad));
       message << "cell (" << ijk[0] << ", " << ijk[1] << ", " << ijk[2] << ") has compressibility "
-              << kappa(first_bad, 0) << " 1/Pa (must be > 0) or a face coefficient that is negative or not finite";
+              << kappa(first_bad, 0) << " 1/Pa (must be > 0) or a face coefficient that is negative or not finite"
+              << " (faces x-, x+, y-, y+" << (Dim == 3 ? ", z-, z+" : "") << ":";
+      for (int f = 0; f < 2 * Dim; ++f) {
+        const LocalOrdinal n = neighbours(first_bad, f);
+        if (n < 0) message << " wall";
+        else message << " " << beta.direction[f / 2](f % 2 == 0 ? first_bad : n, 0);
+      }
+      message << " m^3/kg)";
     } else {
       message << "a bad coefficient on another rank";
     }

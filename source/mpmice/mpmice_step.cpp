@@ -32,6 +32,7 @@ MpmIceStep<Dim>::MpmIceStep(const Scene& scene, std::shared_ptr<const Layout<Dim
       for (const mpm::SolidMaterial& s : mpm_->materials())
         solids.push_back(SolidProperties{s.scene_index, s.bulk_modulus, s.density, s.rigid});
     ice_ = std::make_unique<IceSolver<Dim>>(scene, layout_, solids);
+    ice_->setSolidReferencePressure(state.pressure);
   }
   if (ice_ && mpm_) {
     // The solids' share of every cell is that of their particles' GIMP domains; the fluids fill the
@@ -137,11 +138,16 @@ void MpmIceStep<Dim>::cellsFromParticles(CellState<Dim>& state)
   Kokkos::parallel_for(
       "mpmice::cellsFromParticles", Kokkos::RangePolicy<ExecutionSpace>(0, state.density.overlapCount()),
       KOKKOS_LAMBDA(const LocalOrdinal c) {
+        // The particles' domains of two solids can overlap in a cell where their particles do not
+        // (each fills its own GIMP box): the solids then share the cell in proportion.
+        double solid_volume = 0;
+        for (int a = 0; a < nm; ++a) solid_volume += sums(c, nm + a);
+        const double scale = solid_volume > volume ? volume / solid_volume : 1.0;
         for (int a = 0; a < nm; ++a) {
           const int m = scene_index[a];
           const double mass = sums(c, a);
           rho(c, m) = mass / volume;
-          theta(c, m) = sums(c, nm + a) / volume;
+          theta(c, m) = scale * sums(c, nm + a) / volume;
           for (int d = 0; d < Dim; ++d) {
             const double velocity = mass > 0 ? sums(c, 2 * nm + a * Dim + d) / mass : 0.0;
             u(c, m * Dim + d) = velocity;

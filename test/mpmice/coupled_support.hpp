@@ -1,0 +1,186 @@
+#pragma once
+// Helpers for tests of the coupled step on small scenes written inline as YAML.
+#include "../ice/ice_scene_support.hpp"
+#include "mpmice/mpmice_step.hpp"
+
+#include <array>
+#include <cmath>
+#include <map>
+#include <vector>
+
+namespace cfdmpm::test {
+
+/// A tank of water (and air above when `water_top` < the tank's top) on nx x ny cells with
+/// `solids` (YAML of the solid materials) and `regions` (YAML of their regions), closed by no-slip
+/// walls. `extra` is appended inside `cfdmpm:` (e.g. an `mpm:` or `ice:` section).
+inline std::string tankScene(double width, double height, long long nx, long long ny, double water_top,
+                             const std::string& solids, const std::string& regions, const std::string& extra = "",
+                             double gravity = -9.81)
+{
+  const bool air = water_top < height;
+  std::string text = R"(
+cfdmpm:
+  domain: {dimension: 2, lower: [0.0, 0.0], upper: [)" + std::to_string(width) + ", " + std::to_string(height) +
+                     "], cells: [" + std::to_string(nx) + ", " + std::to_string(ny) + "], patch_cells: [10, 10], gravity: [0.0, " +
+                     std::to_string(gravity) + R"(]}
+  materials:
+)" + solids + R"(
+    water:
+      kind: fluid
+      equation_of_state: {type: linear_water, bulk_modulus: 2.15e9, reference_density: 1000.0, reference_pressure: 101325.0, reference_temperature: 293.15, thermal_expansion: 0.0}
+      viscosity: 1.0e-3
+      specific_heat: 4180.0
+)";
+  if (air)
+    text += R"(    air:
+      kind: fluid
+      equation_of_state: {type: ideal_gas, gas_constant: 287.0, gamma: 1.4}
+      viscosity: 1.8e-5
+)";
+  text += std::string("  initial_state: {background_material: ") + (air ? "air" : "water") +
+          ", temperature: 293.15, pressure: 101325.0}\n  regions:\n";
+  if (air)
+    text += "    water_level: {material: water, shape: half_plane, point: [0.0, " + std::to_string(water_top) +
+            "], normal: [0.0, 1.0]}\n";
+  text += regions + "\n  time: {end_time: 1.0, cfl: 0.25, dt_initial: 1.0e-5}\n  output: {directory: unused, interval: 0.0}\n" +
+          extra + "\n";
+  return text;
+}
+
+/// A polygon approximating a disk (n vertices), as a YAML flow sequence.
+inline std::string diskVertices(double cx, double cy, double radius, int n = 64)
+{
+  std::string out = "[";
+  for (int k = 0; k < n; ++k) {
+    const double a = 2 * M_PI * k / n;
+    out += (k ? ", [" : "[") + std::to_string(cx + radius * std::cos(a)) + ", " + std::to_string(cy + radius * std::sin(a)) + "]";
+  }
+  return out + "]";
+}
+
+/// The coupled step on a scene: layout, state, stepper, and a clock.
+template <int Dim>
+struct CoupledRun {
+  CoupledRun(const Scene& s, const Teuchos::RCP<const Teuchos::Comm<int>>& comm)
+      : scene(s),
+        layout(std::make_shared<const Layout<Dim>>(Grid<Dim>(s.domain), partitionPatches(Grid<Dim>(s.domain), comm->getSize()),
+                                                   s.domain.ghost_width, comm)),
+        state(layout, int(s.materials.size())),
+        stepper(((void)setInitialState(scene, densityFunctions(scene), state), s), layout, state)
+  {
+  }
+
+  /// One step with the stepper's own Δt (dt_initial first), at most up to `until`.
+  void step(double until)
+  {
+    double dt = steps == 0 ? std::min(scene.time.dt_initial, stepper.stableTimeStep(state, 0).dt)
+                           : stepper.stableTimeStep(state, dt_previous).dt;
+    dt_previous = dt;
+    // As the program does: two equal steps to the end rather than a full one and a sliver.
+    if (time + 2 * dt > until) dt = time + dt > until ? until - time : 0.5 * (until - time);
+    last = stepper.step(state, dt);
+    time += dt;
+    ++steps;
+  }
+  template <class Observe>
+  void runUntil(double end_time, Observe&& observe)
+  {
+    while (time < end_time * (1 - 1e-12)) {
+      step(end_time);
+      observe();
+    }
+  }
+  void runUntil(double end_time)
+  {
+    runUntil(end_time, [] {});
+  }
+
+  mpm::MpmSolver<Dim>& particles() { return *stepper.particles(); }
+
+  /// Mass-weighted mean velocity component d of the particles of MPM material a (collective).
+  double meanParticleVelocity(int a, int d)
+  {
+    auto& p = particles().particles();
+    auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.velocity);
+    auto m = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.mass);
+    auto mat = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.material);
+    double sums[2] = {0, 0}, total[2] = {0, 0};
+    for (int i = 0; i < p.count; ++i)
+      if (mat(i) == a) sums[0] += m(i) * v(i, d), sums[1] += m(i);
+    Teuchos::reduceAll(*layout->comm(), Teuchos::REDUCE_SUM, 2, sums, total);
+    return total[0] / total[1];
+  }
+
+  /// Largest particle speed of MPM material a (collective).
+  double maxParticleSpeed(int a)
+  {
+    auto& p = particles().particles();
+    auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.velocity);
+    auto mat = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.material);
+    double fastest = 0;
+    for (int i = 0; i < p.count; ++i)
+      if (mat(i) == a) {
+        double s2 = 0;
+        for (int d = 0; d < Dim; ++d) s2 += v(i, d) * v(i, d);
+        fastest = std::max(fastest, std::sqrt(s2));
+      }
+    return globalMax(*layout->comm(), fastest);
+  }
+
+  /// Particle positions by id (host copies of this rank's particles).
+  std::map<long long, std::array<double, 3>> positions()
+  {
+    auto& p = particles().particles();
+    auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.position);
+    auto id = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.id);
+    std::map<long long, std::array<double, 3>> out;
+    for (int i = 0; i < p.count; ++i) {
+      std::array<double, 3> xi{0, 0, 0};
+      for (int d = 0; d < Dim; ++d) xi[d] = x(i, d);
+      out[id(i)] = xi;
+    }
+    return out;
+  }
+
+  /// Largest speed of fluid material m over owned cells where it fills more than `share` (collective).
+  double maxFluidSpeed(int m, double share = 1e-3)
+  {
+    const auto u = state.velocity.view();
+    const auto theta = state.volume_fraction.view();
+    double fastest = 0;
+    for (LocalOrdinal c = 0; c < state.velocity.ownedCount(); ++c) {
+      if (!(theta(c, m) > share)) continue;
+      double s2 = 0;
+      for (int d = 0; d < Dim; ++d) s2 += u(c, m * Dim + d) * u(c, m * Dim + d);
+      fastest = std::max(fastest, std::sqrt(s2));
+    }
+    return globalMax(*layout->comm(), fastest);
+  }
+
+  /// Total mass (per metre in 2-D) and momentum component d of fluid material m (collective).
+  double fluidMass(int m)
+  {
+    const auto rho = state.density.view();
+    double sum = 0;
+    for (LocalOrdinal c = 0; c < state.density.ownedCount(); ++c) sum += rho(c, m);
+    return globalSum(*layout->comm(), sum * layout->grid().cellVolume());
+  }
+  double fluidMomentum(int m, int d)
+  {
+    const auto rho = state.density.view();
+    const auto u = state.velocity.view();
+    double sum = 0;
+    for (LocalOrdinal c = 0; c < state.density.ownedCount(); ++c) sum += rho(c, m) * u(c, m * Dim + d);
+    return globalSum(*layout->comm(), sum * layout->grid().cellVolume());
+  }
+
+  Scene scene;
+  std::shared_ptr<const Layout<Dim>> layout;
+  CellState<Dim> state;
+  MpmIceStep<Dim> stepper;
+  CoupledStepReport last;
+  double time = 0, dt_previous = 0;
+  long long steps = 0;
+};
+
+}  // namespace cfdmpm::test

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <memory>
 #include <string>
+#include <vector>
 #include <unistd.h>
 
 namespace cfdmpm::test {
@@ -108,6 +109,20 @@ inline double globalMax(const Teuchos::Comm<int>& comm, double local)
 {
   double total = 0;
   Teuchos::reduceAll(comm, Teuchos::REDUCE_MAX, local, Teuchos::outArg(total));
+  return total;
+}
+
+// Every owned value of a field, placed at its global id, summed over ranks: the whole field on
+// every rank (for comparing runs on different partitions; small grids only).
+inline std::vector<double> gatherField(const Field<2>& field)
+{
+  const auto& map = *field.layout().ownedCellMap();
+  const int columns = field.columns();
+  std::vector<double> local(field.layout().grid().cellCount() * columns, 0.0), total(local.size());
+  const auto v = field.view();
+  for (LocalOrdinal c = 0; c < field.ownedCount(); ++c)
+    for (int k = 0; k < columns; ++k) local[map.getGlobalElement(c) * columns + k] = v(c, k);
+  Teuchos::reduceAll(*field.layout().comm(), Teuchos::REDUCE_SUM, int(local.size()), local.data(), total.data());
   return total;
 }
 

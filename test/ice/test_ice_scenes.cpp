@@ -47,19 +47,6 @@ std::vector<double> waterDepth(const CellState<2>& state)
   return total;
 }
 
-// Every owned value of a field, placed at its global id, summed over ranks: the whole field on
-// every rank (for comparing runs on different partitions; small grids only).
-std::vector<double> gatherField(const Field<2>& field)
-{
-  const auto& map = *field.layout().ownedCellMap();
-  const int columns = field.columns();
-  std::vector<double> local(field.layout().grid().cellCount() * columns, 0.0), total(local.size());
-  const auto v = field.view();
-  for (LocalOrdinal c = 0; c < field.ownedCount(); ++c)
-    for (int k = 0; k < columns; ++k) local[map.getGlobalElement(c) * columns + k] = v(c, k);
-  Teuchos::reduceAll(*field.layout().comm(), Teuchos::REDUCE_SUM, int(local.size()), local.data(), total.data());
-  return total;
-}
 
 
 }  // namespace

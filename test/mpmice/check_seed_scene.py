@@ -1,0 +1,57 @@
+"""Checks a short run of the seed scene (Rzadkiewicz slide): every material's mass conserved (fluids
+to round-off, particles exactly), the sand's centre of mass lower than at the start, every value
+finite, and the kinetic energy of all materials no more than the potential energy that the sand's
+descent released (its buoyant weight times its drop: the energy budget allows nothing else)."""
+import csv
+import glob
+import math
+import sys
+
+import h5py
+import numpy as np
+
+out = sys.argv[1]
+rows = list(csv.DictReader(open(glob.glob(out + "/*.csv")[0])))
+failures = []
+
+
+def check(ok, what):
+    print(("ok    " if ok else "FAIL  ") + what)
+    if not ok:
+        failures.append(what)
+
+
+first, last = rows[0], rows[-1]
+for fluid in ("water", "air"):
+    m0, m1 = float(first["mass_" + fluid]), float(last["mass_" + fluid])
+    # Advection conserves mass to round-off; 1e-12 relative allows the sums' rounding over the steps.
+    check(abs(m1 - m0) <= 1e-12 * m0, "%s mass %.15g -> %.15g" % (fluid, m0, m1))
+for solid in ("bed", "sand"):
+    check(first["mass_" + solid] == last["mass_" + solid], "%s particle mass unchanged (%s)" % (solid, last["mass_" + solid]))
+finite = all(math.isfinite(float(v)) for r in rows for k, v in r.items() if k != "dt_limiter")
+check(finite, "every CSV value finite")
+
+steps = sorted(glob.glob(out + "/*_[0-9]*.h5"))
+SAND = 1  # scene material index of the sand (bed, sand, water, air)
+
+
+def sand_centre(path):
+    with h5py.File(path, "r") as f:
+        x = f["particles/position"][:]
+        m = f["particles/material"][:]
+        return x[m == SAND].mean(axis=0)
+
+
+c0, c1 = sand_centre(steps[0]), sand_centre(steps[-1])
+drop = c0[1] - c1[1]
+check(drop > 0, "sand centre of mass moved down by %.4f m (from %s to %s)" % (drop, c0, c1))
+with h5py.File(steps[-1], "r") as f:
+    check(all(np.isfinite(f[k][:]).all() for k in ("cells/pressure", "particles/position", "particles/velocity")),
+          "pressure and particles finite at the end")
+
+rho_s, rho_w, g = 1985.0, 999.8, 9.81
+sand_mass = float(last["mass_sand"])
+released = (1 - rho_w / rho_s) * sand_mass * g * max(drop, 0.0)
+kinetic = sum(float(last[k]) for k in ("kinetic_energy_water", "kinetic_energy_air", "kinetic_energy_particles"))
+check(kinetic <= released, "kinetic energy %.4g J/m within the released %.4g J/m" % (kinetic, released))
+sys.exit(1 if failures else 0)

@@ -254,19 +254,19 @@ void MpmSolver<Dim>::step(double dt)
 template <int Dim>
 void MpmSolver<Dim>::particlesToGrid()
 {
-  if (options_.shape_function == ShapeFunction::Gimp)
-    particlesToGridWith<UniformGimp>();
-  else
-    particlesToGridWith<LinearHat>();
+  withShapeFunction([&](auto kernel) {
+    using K = decltype(kernel);
+    particlesToGridWith<K>();
+  });
 }
 
 template <int Dim>
 void MpmSolver<Dim>::gridToParticles(double dt)
 {
-  if (options_.shape_function == ShapeFunction::Gimp)
-    gridToParticlesWith<UniformGimp>(dt);
-  else
-    gridToParticlesWith<LinearHat>(dt);
+  withShapeFunction([&](auto kernel) {
+    using K = decltype(kernel);
+    gridToParticlesWith<K>(dt);
+  });
 }
 
 template <int Dim>
@@ -593,19 +593,19 @@ struct CellOverlap {
 template <int Dim>
 void MpmSolver<Dim>::particlesToCells(Field<Dim>& sums)
 {
-  if (options_.shape_function == ShapeFunction::Gimp)
-    particlesToCellsWith<UniformGimp>(sums);
-  else
-    particlesToCellsWith<LinearHat>(sums);
+  withShapeFunction([&](auto kernel) {
+    using K = decltype(kernel);
+    particlesToCellsWith<K>(sums);
+  });
 }
 
 template <int Dim>
 void MpmSolver<Dim>::addCellVelocityChange(const Field<Dim>& change)
 {
-  if (options_.shape_function == ShapeFunction::Gimp)
-    addCellVelocityChangeWith<UniformGimp>(change);
-  else
-    addCellVelocityChangeWith<LinearHat>(change);
+  withShapeFunction([&](auto kernel) {
+    using K = decltype(kernel);
+    addCellVelocityChangeWith<K>(change);
+  });
 }
 
 template <int Dim>

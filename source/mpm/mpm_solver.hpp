@@ -16,6 +16,7 @@
 #include "mpm/migration.hpp"
 #include "mpm/particle_bins.hpp"
 #include "mpm/particles.hpp"
+#include "mpm/shape_functions.hpp"
 #include "mpm/solid_material.hpp"
 
 #include <array>
@@ -161,6 +162,16 @@ class MpmSolver {
   const Field<Dim>& nodeVelocityStar() const { return *node_velocity_star_; }
 
  private:
+  /// f(UniformGimp()) or f(LinearHat()), as the options choose: each phase's kernel is a template
+  /// on the shape function.
+  template <class F>
+  void withShapeFunction(F&& f) const
+  {
+    if (options_.shape_function == ShapeFunction::Gimp)
+      f(UniformGimp());
+    else
+      f(LinearHat());
+  }
   template <class Kernel>
   void particlesToGridWith();
   template <class Kernel>

@@ -287,6 +287,7 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
   const auto p = state.pressure.view();
   const auto K = pairCoefficients(settings_.exchange_coefficient, n, roles_, true);
   const auto roles = roles_;
+  const bool with_solids = roles_.any_solid;
   forMaterialCount(n, [&](auto count) {
     constexpr int N = decltype(count)::value;
     for (int d = 0; d < Dim; ++d) {
@@ -319,7 +320,18 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
                        : roles.lagrangian[m] ? mean - dt_per_h * vbar * pressure_difference
                                              : mean - dt_per_h * vbar * pressure_difference + dt * g;
             }
-            ice::exchangeMomentumFC<N>(nm, dt, K, tl, tr, vl, vr, vel, sv);
+            if (with_solids) {
+              // A solid couples a face by the share it has on both sides: at the front of a body that
+              // fills one cell and not the next, the fluid between its front and the face is not in
+              // the solid, and must leave ahead of it. (Coupled by the mean share, the fluid of the
+              // front cell would be held to the solid and squeezed as the front advances.)
+              ice::MaterialArray<double> el = tl, er = tr;
+              for (int m = 0; m < nm; ++m)
+                if (roles.lagrangian[m]) el[m] = er[m] = Kokkos::Experimental::fmin(tl[m], tr[m]);
+              ice::exchangeMomentumFC<N>(nm, dt, K, el, er, vl, vr, vel, sv);
+            } else {
+              ice::exchangeMomentumFC<N>(nm, dt, K, tl, tr, vl, vr, vel, sv);
+            }
             // A material absent on both sides has no weight in the exchange and would keep its own
             // acceleration (for air inside water, v_air ∇p ~ 800 g); it moves with the mixture
             // instead, whose specific volume is β = Σ θ_f v_f (Σ θ_f = 1).

@@ -5,6 +5,7 @@
 #include "input/scene.hpp"
 
 #include "input/parameter_rule.hpp"
+#include "input/scene_checks.hpp"
 
 #include <Teuchos_Array.hpp>
 #include <Teuchos_Parser.hpp>
@@ -708,6 +709,10 @@ Scene readScene(const std::string& path)
     scene.output = readOutput(root->sublist("output"));
     scene.mpm = readMpm(root->sublist("mpm"));
     checkedSection(root->sublist("ice"), "ice");  // read by the ICE solver (IceSettings::fromScene)
+
+    // 4. The scene as a whole: what the regions place, the solvers' own settings, derived
+    //    quantities, the grid's size (input/scene_checks.hpp).
+    checkSceneAsAWhole(scene);
   } catch (const InputError& error) {
     throw InputError(path + ": " + error.what());
   }

@@ -76,7 +76,7 @@ std::string bytesText(double bytes)
 /// Metres as text with a unit a person reads at once: 0.000625 m -> "0.625 mm".
 std::string lengthText(double metres)
 {
-  if (metres < 1e-2 && metres >= 1e-6) return roughly(metres * 1e3) + " mm";
+  if (metres < 0.1 && metres >= 1e-6) return roughly(metres * 1e3) + " mm";
   return roughly(metres) + " m";
 }
 

@@ -50,10 +50,13 @@ std::string showList(const std::array<long long, 3>& values, int dimension)
   return text + "]";
 }
 
+/// The vertices as written; a long outline shortened to its first points and its count.
 std::string showVertices(const std::vector<std::array<double, 2>>& vertices)
 {
+  const std::size_t shown = vertices.size() > 12 ? 4 : vertices.size();
   std::string text = "[";
-  for (std::size_t k = 0; k < vertices.size(); ++k) text += (k ? ", " : "") + showPoint(vertices[k].data(), 2);
+  for (std::size_t k = 0; k < shown; ++k) text += (k ? ", " : "") + showPoint(vertices[k].data(), 2);
+  if (shown < vertices.size()) text += ", ... (" + std::to_string(vertices.size()) + " points)";
   return text + "]";
 }
 

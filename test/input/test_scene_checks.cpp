@@ -222,5 +222,44 @@ TEST_F(SceneTest, MemoryEstimateNamesCellsAndParticles)
   expectMentions(estimate.detail, {"200 cells (domain.cells)", "3 materials", "particles"});
 }
 
+// --- The file before the YAML reader -------------------------------------------------------------
+
+TEST_F(SceneTest, FileLargerThanTheBoundIsRefusedBeforeParsing)
+{
+  // 1 MiB + a comment line: refused by its size (the reader would take ~12 s per MB).
+  const std::string message = errorOf(kFullScene + "# " + std::string(1 << 20, 'x') + "\n");
+  expectMentions(message, {"scene.yaml", "bytes", "at most 1048576"});
+}
+
+TEST_F(SceneTest, BinaryFileIsRefusedWithoutPrintingItsBytes)
+{
+  const std::string binary = std::string("\x7f" "ELF\x02\x01\x01\0\0\0", 10) + "cfdmpm:\x01\xff\xfe";
+  const std::string message = errorOf(binary);
+  expectMentions(message, {"is not a text file", "byte 0"});
+  EXPECT_EQ(message.find("ELF"), std::string::npos) << message;
+}
+
+TEST_F(SceneTest, NonAsciiCharacterIsNamedWithLineAndColumn)
+{
+  // Line 13 of kFullScene is "    water:"; the name becomes "wäter".
+  const std::string message = errorOf(replaced(kFullScene, "    water:\n", "    w\xc3\xa4ter:\n"));
+  expectMentions(message, {"scene.yaml:13:6:", "U+00E4", "not ASCII"});
+}
+
+TEST_F(SceneTest, NonAsciiCharactersInCommentsAreAccepted)
+{
+  const Scene scene = readScene(write(replaced(kFullScene, "# A scene for the tests", "# Barrage \xc3\xa9t\xc3\xa9, 5 \xc2\xb0" "C")));
+  EXPECT_EQ(scene.title, "Test tank");
+}
+
+TEST_F(SceneTest, NestingBeyondTheBoundIsRefusedBeforeParsing)
+{
+  std::string deep = "  mpm: ";
+  for (int i = 0; i < 40; ++i) deep += "{a: ";
+  deep += "1" + std::string(40, '}') + "\n";
+  const std::string message = errorOf(replaced(kFullScene, "  mpm: {}\n", deep));
+  expectMentions(message, {"scene.yaml:43:", "levels deep", "at most 32"});
+}
+
 }  // namespace
 }  // namespace cfdmpm::test

@@ -381,9 +381,9 @@ void checkDerivedQuantities(const Scene& scene)
   }
   // hypot: the squares of a gravity near the largest double would overflow.
   g = std::hypot(domain.gravity[0], domain.gravity[1], dim == 3 ? domain.gravity[2] : 0.0);
-  bool has_solids = false;
-  for (const auto& m : scene.materials) has_solids = has_solids || m.kind == "solid";
-  const bool ice_runs = scene.parameters->sublist("ice").get<bool>("enabled") && !has_solids;
+  // The fluid step (and its pressure equation) runs unless ice.enabled is false, with or without
+  // solids (mpmice/mpmice_step.cpp).
+  const bool ice_runs = scene.parameters->sublist("ice").get<bool>("enabled");
   const std::string gravity_value = showPoint(domain.gravity.data(), dim);
 
   // Gravity: a body at rest must not fall more than a cell in the first step, dt_initial (the
@@ -464,13 +464,22 @@ void checkDerivedQuantities(const Scene& scene)
 
 void checkSolverSettings(const Scene& scene)
 {
-  bool has_solids = false;
   int solids = 0;
-  for (const auto& m : scene.materials) has_solids = has_solids || m.kind == "solid", solids += m.kind == "solid";
-  const bool ice_runs = scene.parameters->sublist("ice").get<bool>("enabled") && !has_solids;
+  std::string first_solid;
+  for (const auto& m : scene.materials)
+    if (m.kind == "solid" && solids++ == 0) first_solid = m.name;
+  // As the coupled step builds its solvers (mpmice/mpmice_step.cpp, ice/ice_solver.cpp): the fluid
+  // step, which runs unless ice.enabled is false, holds every material, solids included.
+  const auto& ice = scene.parameters->sublist("ice");
+  const bool ice_runs = ice.get<bool>("enabled");
   if (ice_runs && int(scene.materials.size()) > ice::kMaxMaterials) {
     throw inputError("cfdmpm.materials", std::to_string(scene.materials.size()) + " materials",
                      "the fluid solver handles at most " + std::to_string(ice::kMaxMaterials));
+  }
+  if (ice_runs && solids > 0 && !ice.get<bool>("isothermal")) {
+    throw inputError("cfdmpm.ice.isothermal", "false",
+                     "allowed: true in a scene with the solid material '" + first_solid +
+                         "'; the coupled step does not carry the solids' temperature yet");
   }
   if (solids > kMaxSolidMaterials) {
     throw inputError("cfdmpm.materials", std::to_string(solids) + " solid materials",

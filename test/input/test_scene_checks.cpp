@@ -145,6 +145,15 @@ TEST_F(SceneTest, LinearSolverKeysAreCheckedWithTheScene)
                  {"cfdmpm.ice.linear_solver.verbosity", "integer"});
 }
 
+TEST_F(SceneTest, EnergyEquationWithSolidsIsRefusedWithTheScene)
+{
+  // The coupled step does not carry the solids' temperature: the fluid solver refuses it, and so
+  // does the scene reader.
+  expectMentions(errorOf(replaced(kFullScene, kIce, "  ice: {isothermal: false}\n")),
+                 {"cfdmpm.ice.isothermal", "false", "sand"});
+  EXPECT_NO_THROW(readScene(write(replaced(fluidsOnly(kFullScene), kIce, "  ice: {isothermal: false}\n"))));
+}
+
 TEST_F(SceneTest, HydrostaticWithGravityOffAxisIsRefusedWithTheScene)
 {
   std::string text = replaced(kFullScene, "hydrostatic: false", "hydrostatic: true");

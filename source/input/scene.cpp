@@ -13,6 +13,7 @@
 #include <Teuchos_YamlParameterListHelpers.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -141,6 +142,21 @@ std::string screenText(const std::string& text, const std::string& path)
       while (!indents.empty() && indents.back() >= indent) indents.pop_back();
       indents.push_back(indent);
       at_line_start = false;
+    }
+    if (c == '-' && token_start && i + 4 < text.size() && text[i + 1] == '.') {
+      // YAML's -.inf, which the reader cannot parse (it reads .inf as a string, refused later as
+      // "expected a number"): say so with the key before it on the line.
+      std::string word = text.substr(i + 2, 3);
+      for (char& w : word) w = char(std::tolower(static_cast<unsigned char>(w)));
+      if (word == "inf" || word == "nan") {
+        const std::string before_token = text.substr(line_start, i - line_start);
+        const std::size_t colon = before_token.find_last_of(':');
+        std::size_t key_start = before_token.find_last_of(" \t{,", colon == std::string::npos ? 0 : colon - 1);
+        key_start = key_start == std::string::npos ? 0 : key_start + 1;
+        const std::string key = colon == std::string::npos ? "" : before_token.substr(key_start, colon - key_start);
+        throw InputError(lineColumn(path, line, i - line_start + 1) + (key.empty() ? "" : key + ": ") + "got '" +
+                         text.substr(i, 5) + "'; numbers must be finite (neither .inf nor -.inf nor .nan)");
+      }
     }
     if (c == '#' && token_start) in_comment = true;
     else if (c == '"' && token_start) in_double = true;

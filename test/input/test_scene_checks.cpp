@@ -261,6 +261,16 @@ TEST_F(SceneTest, NonAsciiCharactersInCommentsAreAccepted)
   EXPECT_EQ(scene.title, "Test tank");
 }
 
+TEST_F(SceneTest, NegativeInfinityIsRefusedLikeInfinity)
+{
+  // .inf reads as a string and is refused as not a number; -.inf used to be a syntax error.
+  expectMentions(errorOf(replaced(kFullScene, "viscosity: 1.0e-3", "viscosity: .inf")),
+                 {"cfdmpm.materials.water.viscosity", "'.inf'", "expected a number"});
+  expectMentions(errorOf(replaced(kFullScene, "viscosity: 1.0e-3", "viscosity: -.inf")),
+                 {"scene.yaml:16:18:", "viscosity: got '-.inf'", "must be finite"});
+  expectMentions(errorOf(replaced(kFullScene, "cfl: 0.4", "cfl: -.Inf")), {"cfl: got '-.Inf'", "must be finite"});
+}
+
 TEST_F(SceneTest, NestingBeyondTheBoundIsRefusedBeforeParsing)
 {
   std::string deep = "  mpm: ";

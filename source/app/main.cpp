@@ -1,9 +1,14 @@
 // cfdmpm: the program. Run as `cfdmpm [options] scene.yaml`, under `mpiexec -n N` for N ranks.
+#include "input/parameter_rule.hpp"
 #include "input/scene.hpp"
+#include "input/scene_checks.hpp"
 #include "mpmice/simulation.hpp"
 
 #include <Tpetra_Core.hpp>
 
+#include <unistd.h>
+
+#include <cmath>
 #include <cstring>
 #include <iostream>
 #include <string>
@@ -19,17 +24,50 @@ const char* kUsage =
     "\n"
     "options:\n"
     "  --overwrite   replace the output of an earlier run in the scene's output directory\n"
-    "  --check       validate the scene file and stop\n"
+    "  --check       validate the scene file and stop: every check a run makes before its first\n"
+    "                step (run it under mpiexec -n N to check the patches for N ranks), and what\n"
+    "                each region places\n"
     "  --help        print this help\n"
     "  --version     print the version\n"
     "\n"
-    "exit codes: 0 success, 1 run-time failure, 2 bad input or bad command line\n";
+    "exit codes: 0 the run reached its end (or --check passed), 1 run-time failure, 2 bad input or\n"
+    "            bad command line, 3 stopped by SIGINT or SIGTERM before its end (the files written\n"
+    "            are complete; a second signal ends the program at once)\n";
 
 struct CommandLine {
   std::string scene;
   cfdmpm::RunOptions options;
   bool check_only = false;
 };
+
+/// Writes a message with one write() call, so that the lines of ranks failing together do not
+/// interleave within a line (writes of up to PIPE_BUF bytes to a pipe are atomic).
+void writeError(const std::string& message)
+{
+  const std::string text = message.back() == '\n' ? message : message + "\n";
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::write(STDERR_FILENO, text.data() + done, text.size() - done);
+    if (n <= 0) break;
+    done += std::size_t(n);
+  }
+}
+
+/// One line per region: what it places on its own (later regions may overwrite part of it).
+void printPlacements(const cfdmpm::Scene& scene)
+{
+  for (const cfdmpm::RegionPlacement& p : cfdmpm::regionPlacements(scene)) {
+    std::cout << "  region " << p.region << ": " << p.material << ", ";
+    if (p.points < 0)
+      std::cout << "(too large to count)";
+    else if (p.solid)
+      std::cout << cfdmpm::showNumber(p.points) << " particles (" << cfdmpm::showNumber(std::round(p.cells * 10) / 10)
+                << " cells' worth)";
+    else
+      std::cout << cfdmpm::showNumber(std::round(p.cells * 10) / 10) << " cells' worth";
+    std::cout << "\n";
+  }
+}
 
 }  // namespace
 
@@ -74,8 +112,14 @@ int main(int argc, char** argv)
   try {
     // 3. Read and validate the scene on every rank; a bad file stops here, before any output.
     const cfdmpm::Scene scene = cfdmpm::readScene(command.scene);
+    //    Then the set-up checks that depend on the ranks and the machine (memory, patches per
+    //    rank, output directory), nothing created; the run makes them again as it sets up.
+    cfdmpm::checkSetUp(scene, comm, command.options.overwrite);
     if (command.check_only) {
-      if (root) std::cout << "cfdmpm: " << command.scene << " is valid\n";
+      if (root) {
+        std::cout << "cfdmpm: " << command.scene << " is valid for " << comm->getSize() << " rank(s)\n";
+        printPlacements(scene);
+      }
       return 0;
     }
     // 4. Run it.
@@ -84,14 +128,22 @@ int main(int argc, char** argv)
       std::cout << "cfdmpm: output in " << summary.output_directory << "\n"
                 << "  fields (open in ParaView): " << summary.time_series << "\n"
                 << "  diagnostics: " << summary.diagnostics << "\n";
-      if (summary.stopped_by_signal) std::cout << "cfdmpm: stopped by a signal; the files written are complete\n";
+    }
+    // A run stopped by SIGINT or SIGTERM before its end time did not finish: exit 3 on every rank
+    // (stopped_by_signal is the same on all of them).
+    const double end = scene.time.end_time;
+    if (summary.stopped_by_signal && summary.time < end - 1e-12 * end) {
+      if (root)
+        std::cout << "cfdmpm: stopped by a signal at t = " << cfdmpm::showNumber(summary.time) << " s of "
+                  << cfdmpm::showNumber(end) << " s; the files written are complete\n";
+      return 3;
     }
     return 0;
   } catch (const cfdmpm::InputError& e) {
-    if (root) std::cerr << "cfdmpm: error: " << e.what() << "\n";
+    if (root) writeError(std::string("cfdmpm: error: ") + e.what());
     return 2;
   } catch (const std::exception& e) {
-    std::cerr << "cfdmpm: rank " << comm->getRank() << ": failure: " << e.what() << "\n";
+    writeError("cfdmpm: rank " + std::to_string(comm->getRank()) + ": failure: " + e.what());
     return 1;
   }
 }

@@ -3,6 +3,7 @@
 #include "ice/pressure_solver.hpp"
 
 #include "common/error.hpp"
+#include "input/parameter_rule.hpp"
 
 #include <BelosLinearProblem.hpp>
 #include <BelosPseudoBlockCGSolMgr.hpp>
@@ -53,41 +54,67 @@ struct Settings {
   double reuse_slowdown_limit = 0;  // 0: off
 };
 
-Settings readSettings(Teuchos::ParameterList& list, const Teuchos::ParameterList& valid)
+std::string keysOf(const Teuchos::ParameterList& list)
 {
+  std::string keys;
+  for (auto it = list.begin(); it != list.end(); ++it) keys += (keys.empty() ? "" : ", ") + list.name(it);
+  return keys;
+}
+
+/// `prefix` starts each message's key ("pressure solver: " or "cfdmpm.ice.linear_solver.").
+Settings readSettings(Teuchos::ParameterList& list, const Teuchos::ParameterList& valid,
+                      const std::string& prefix = "pressure solver: ")
+{
+  // Unknown keys and wrong types first, each named with what is allowed (Teuchos's own message
+  // dumps the whole valid list).
+  for (auto it = list.begin(); it != list.end(); ++it) {
+    const std::string& key = list.name(it);
+    const Teuchos::ParameterEntry* valid_entry = valid.getEntryPtr(key);
+    if (!valid_entry) throw InputError(prefix + key + ": unknown key; allowed keys: " + keysOf(valid));
+    const Teuchos::ParameterEntry& entry = list.entry(it);
+    if (entry.isList() != valid_entry->isList() ||
+        (!entry.isList() && entry.getAny(false).type() != valid_entry->getAny(false).type() &&
+         !(valid_entry->isType<double>() && entry.isType<int>())))
+      throw InputError(prefix + key + ": got a value of the wrong type; expected " +
+                       (valid_entry->isList()              ? std::string("a section")
+                        : valid_entry->isType<double>()    ? std::string("a number")
+                        : valid_entry->isType<int>()       ? std::string("an integer")
+                                                           : std::string("a string")));
+    if (valid_entry->isType<double>() && entry.isType<int>()) list.set(key, double(entry.getValue<int>(nullptr)));
+  }
   try {
     // Depth 0: the "muelu" sublist is MueLu's to validate.
     list.validateParametersAndSetDefaults(valid, 0);
   } catch (const std::exception& e) {
-    throw InputError(std::string("pressure solver settings: ") + e.what());
+    throw InputError(prefix + "settings: " + e.what());
   }
   Settings s;
   s.tolerance = list.get<double>("tolerance");
   if (!(s.tolerance > 0 && s.tolerance < 1))
-    throw inputError("pressure solver: tolerance", std::to_string(s.tolerance), "must lie in (0, 1)");
+    throw inputError(prefix + "tolerance", showNumber(s.tolerance), "must lie in (0, 1)");
   s.maximum_iterations = list.get<int>("maximum iterations");
   if (s.maximum_iterations < 1)
-    throw inputError("pressure solver: maximum iterations", std::to_string(s.maximum_iterations), "must be >= 1");
+    throw inputError(prefix + "maximum iterations", std::to_string(s.maximum_iterations), "must be >= 1");
   const std::string preconditioner = list.get<std::string>("preconditioner");
   if (preconditioner == "muelu") s.preconditioner = PreconditionerType::MueLu;
   else if (preconditioner == "jacobi") s.preconditioner = PreconditionerType::Jacobi;
   else if (preconditioner == "none") s.preconditioner = PreconditionerType::None;
-  else throw inputError("pressure solver: preconditioner", preconditioner, "allowed: muelu, jacobi, none");
+  else throw inputError(prefix + "preconditioner", preconditioner, "allowed: muelu, jacobi, none");
   s.verbosity = list.get<int>("verbosity");
   if (s.verbosity < 0 || s.verbosity > 2)
-    throw inputError("pressure solver: verbosity", std::to_string(s.verbosity), "allowed: 0, 1, 2");
+    throw inputError(prefix + "verbosity", std::to_string(s.verbosity), "allowed: 0, 1, 2");
   s.reuse_interval = list.get<int>("reuse interval");
   if (s.reuse_interval < 1)
-    throw inputError("pressure solver: reuse interval", std::to_string(s.reuse_interval), "must be >= 1");
+    throw inputError(prefix + "reuse interval", std::to_string(s.reuse_interval), "must be >= 1");
   const std::string mode = list.get<std::string>("reuse mode");
   if (mode == "RAP") s.reuse_mode = ReuseMode::KeepRAP;
   else if (mode == "RP") s.reuse_mode = ReuseMode::KeepRP;
   else if (mode == "tP") s.reuse_mode = ReuseMode::KeepTentativeP;
   else if (mode == "frozen") s.reuse_mode = ReuseMode::Frozen;
-  else throw inputError("pressure solver: reuse mode", mode, "allowed: RAP, RP, tP, frozen");
+  else throw inputError(prefix + "reuse mode", mode, "allowed: RAP, RP, tP, frozen");
   s.reuse_slowdown_limit = list.get<double>("reuse slowdown limit");
   if (!(s.reuse_slowdown_limit == 0 || s.reuse_slowdown_limit >= 1))
-    throw inputError("pressure solver: reuse slowdown limit", std::to_string(s.reuse_slowdown_limit),
+    throw inputError(prefix + "reuse slowdown limit", showNumber(s.reuse_slowdown_limit),
                      "must be 0 (off) or >= 1");
   return s;
 }
@@ -382,6 +409,13 @@ PressureSolver<Dim>::PressureSolver(std::shared_ptr<const Layout<Dim>> layout, c
 
 template <int Dim>
 PressureSolver<Dim>::~PressureSolver() = default;
+
+template <int Dim>
+void PressureSolver<Dim>::checkSettings(const Teuchos::ParameterList& settings, const std::string& key_prefix)
+{
+  Teuchos::ParameterList copy = settings;
+  readSettings(copy, *validParameters(), key_prefix);
+}
 
 template <int Dim>
 Teuchos::RCP<const Teuchos::ParameterList> PressureSolver<Dim>::validParameters()

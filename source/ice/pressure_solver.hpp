@@ -65,6 +65,10 @@ class PressureSolver {
   ///   factor more iterations per decade than the last fresh hierarchy), and a sublist "muelu"
   ///   passed to MueLu on top of cfdmpm's defaults.
   static Teuchos::RCP<const Teuchos::ParameterList> validParameters();
+  /// Checks settings as the constructor does, without building anything: throws InputError for an
+  /// unknown key, a wrong type or a bad value, the key named after `key_prefix`. The "muelu"
+  /// sublist is checked by MueLu when the preconditioner is first built.
+  static void checkSettings(const Teuchos::ParameterList& settings, const std::string& key_prefix);
   /// The settings in use, defaults filled in.
   const Teuchos::ParameterList& settings() const;
 

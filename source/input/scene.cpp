@@ -5,6 +5,7 @@
 #include "input/scene.hpp"
 
 #include "input/parameter_rule.hpp"
+#include "input/scene_checks.hpp"
 
 #include <Teuchos_Array.hpp>
 #include <Teuchos_Parser.hpp>
@@ -12,6 +13,7 @@
 #include <Teuchos_YamlParameterListHelpers.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -58,6 +60,117 @@ std::string readText(const std::string& path)
   std::fclose(file);
   if (read_error) throw InputError(path + ": cannot read the scene file: " + std::strerror(read_error));
   return text;
+}
+
+// The YAML reader is slow on large input (~12 s per MB of a long flow list, measured) and stops on
+// any byte above 127, even in a comment. Real scenes are a few kB; one with a surveyed outline of
+// 10^4 polygon points is ~200 kB. Nesting: the deepest key of a scene is 4-6 levels down
+// (cfdmpm.ice.linear_solver.muelu.<...>).
+constexpr std::size_t kMaxSceneBytes = 1 << 20;
+constexpr int kMaxSceneDepth = 32;
+
+std::string lineColumn(const std::string& path, int line, std::size_t column)
+{
+  return path + ":" + std::to_string(line) + ":" + std::to_string(column) + ": ";
+}
+
+// Before the YAML reader: the file's size, bytes that are not text, non-ASCII characters outside
+// comments (named with line, column and code point) and the nesting depth. Returns the text with
+// the non-ASCII characters of comments blanked, which is what the reader gets.
+std::string screenText(const std::string& text, const std::string& path)
+{
+  if (text.size() > kMaxSceneBytes) {
+    throw InputError(path + ": the file has " + std::to_string(text.size()) + " bytes; a scene file may have at most " +
+                     std::to_string(kMaxSceneBytes) + " (1 MiB), since the YAML reader needs seconds per 100 kB");
+  }
+  std::string screened = text;
+  int line = 1, flow_depth = 0;
+  std::size_t line_start = 0;
+  bool in_comment = false, in_single = false, in_double = false, at_line_start = true;
+  std::vector<std::size_t> indents;  // the block structure: indentation of each open level
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    if (c == '\n') {
+      ++line, line_start = i + 1, in_comment = in_single = in_double = false, at_line_start = true;
+      continue;
+    }
+    if ((c < 32 && c != '\t' && c != '\r') || c == 127) {
+      throw InputError(path + ": is not a text file (byte " + std::to_string(i) + ", on line " + std::to_string(line) +
+                       ", is the control character " + std::to_string(c) + "); give the scene's YAML file");
+    }
+    if (c >= 128) {
+      // The UTF-8 sequence of one character: its length from the first byte, then continuation bytes.
+      const int length = (c & 0xE0) == 0xC0 ? 2 : (c & 0xF0) == 0xE0 ? 3 : (c & 0xF8) == 0xF0 ? 4 : 0;
+      unsigned code = length == 2 ? c & 0x1F : length == 3 ? c & 0x0F : c & 0x07;
+      bool valid = length > 0 && i + length <= text.size();
+      for (int k = 1; valid && k < length; ++k) {
+        const unsigned char next = static_cast<unsigned char>(text[i + k]);
+        valid = (next & 0xC0) == 0x80;
+        code = code << 6 | (next & 0x3F);
+      }
+      if (!valid) {
+        throw InputError(path + ": is not a text file (byte " + std::to_string(i) + ", on line " + std::to_string(line) +
+                         ", is not UTF-8); give the scene's YAML file");
+      }
+      if (in_comment) {
+        for (int k = 0; k < length; ++k) screened[i + k] = ' ';
+        i += length - 1;
+        continue;
+      }
+      char hex[16];
+      std::snprintf(hex, sizeof hex, "U+%04X", code);
+      throw InputError(lineColumn(path, line, i - line_start + 1) + "the character '" + text.substr(i, length) + "' (" +
+                       hex + ") is not ASCII; the YAML reader takes ASCII only (outside comments): write names, "
+                       "keys and titles with ASCII letters");
+    }
+    if (in_comment) continue;
+    if (in_double) {
+      if (c == '\\') ++i;
+      else if (c == '"') in_double = false;
+      continue;
+    }
+    if (in_single) {
+      if (c == '\'') in_single = false;
+      continue;
+    }
+    const char before = i > line_start ? text[i - 1] : ' ';
+    const bool token_start = before == ' ' || before == '\t' || before == '[' || before == '{' || before == ',' ||
+                             before == ':';
+    if (at_line_start && c != ' ' && c != '\t' && c != '\r' && c != '#') {
+      // A line with content: its indentation closes the deeper block levels and opens one.
+      const std::size_t indent = i - line_start;
+      while (!indents.empty() && indents.back() >= indent) indents.pop_back();
+      indents.push_back(indent);
+      at_line_start = false;
+    }
+    if (c == '-' && token_start && i + 4 < text.size() && text[i + 1] == '.') {
+      // YAML's -.inf, which the reader cannot parse (it reads .inf as a string, refused later as
+      // "expected a number"): say so with the key before it on the line.
+      std::string word = text.substr(i + 2, 3);
+      for (char& w : word) w = char(std::tolower(static_cast<unsigned char>(w)));
+      if (word == "inf" || word == "nan") {
+        const std::string before_token = text.substr(line_start, i - line_start);
+        const std::size_t colon = before_token.find_last_of(':');
+        std::size_t key_start = before_token.find_last_of(" \t{,", colon == std::string::npos ? 0 : colon - 1);
+        key_start = key_start == std::string::npos ? 0 : key_start + 1;
+        const std::string key = colon == std::string::npos ? "" : before_token.substr(key_start, colon - key_start);
+        throw InputError(lineColumn(path, line, i - line_start + 1) + (key.empty() ? "" : key + ": ") + "got '" +
+                         text.substr(i, 5) + "'; numbers must be finite (neither .inf nor -.inf nor .nan)");
+      }
+    }
+    if (c == '#' && token_start) in_comment = true;
+    else if (c == '"' && token_start) in_double = true;
+    else if (c == '\'' && token_start) in_single = true;
+    else if (c == '{' || c == '[') ++flow_depth;
+    else if (c == '}' || c == ']') flow_depth = std::max(0, flow_depth - 1);
+    const int depth = int(indents.size()) + flow_depth;
+    if (depth > kMaxSceneDepth) {
+      throw InputError(lineColumn(path, line, i - line_start + 1) + "the file nests " + std::to_string(depth) +
+                       " levels deep here; a scene nests at most " + std::to_string(kMaxSceneDepth) +
+                       " (its deepest keys are 4 to 6 levels down)");
+    }
+  }
+  return screened;
 }
 
 // The key of a line that starts in column 0: the text before the first ": " (or a final ':'),
@@ -144,10 +257,10 @@ std::string cleanTeuchosMessage(const std::string& message)
   return cleaned;
 }
 
-RCP<ParameterList> parseYaml(const std::string& path)
+RCP<ParameterList> parseYaml(const std::string& text, const std::string& path)
 {
   try {
-    return Teuchos::getParametersFromYamlFile(path);
+    return Teuchos::getParametersFromYamlString(text);
   } catch (const Teuchos::ParserFail& error) {
     // Teuchos' parser reads a subset of YAML; two common forms it rejects get a hint.
     throw InputError(path + ": YAML syntax error: " + cleanTeuchosMessage(error.what()) +
@@ -682,9 +795,9 @@ int Scene::materialIndex(const std::string& name) const
 Scene readScene(const std::string& path)
 {
   // 1. The file: readable, one top-level key `cfdmpm`, valid YAML.
-  const std::string text = readText(path);
+  const std::string text = screenText(readText(path), path);
   refuseOtherTopLevelKeys(text, path);
-  RCP<ParameterList> root = parseYaml(path);
+  RCP<ParameterList> root = parseYaml(text, path);
 
   Scene scene;
   scene.path = path;
@@ -708,6 +821,10 @@ Scene readScene(const std::string& path)
     scene.output = readOutput(root->sublist("output"));
     scene.mpm = readMpm(root->sublist("mpm"));
     checkedSection(root->sublist("ice"), "ice");  // read by the ICE solver (IceSettings::fromScene)
+
+    // 4. The scene as a whole: what the regions place, the solvers' own settings, derived
+    //    quantities, the grid's size (input/scene_checks.hpp).
+    checkSceneAsAWhole(scene);
   } catch (const InputError& error) {
     throw InputError(path + ": " + error.what());
   }

@@ -424,7 +424,7 @@ const std::vector<std::string>& regionShapes()
 const std::vector<std::string>& outputFieldNames()
 {
   static const std::vector<std::string> names{
-      "volume_fraction", "density", "velocity", "temperature", "pressure", "specific_volume", "sound_speed",
+      "volume_fraction", "density", "velocity", "temperature", "pressure", "specific_volume",
       "particle_velocity", "particle_stress", "plastic_strain", "particle_material"};
   return names;
 }

@@ -402,6 +402,9 @@ void Hdf5Writer::writeParticleDataset(const std::string& dataset_path, int compo
                                       open_->dataset_creation.get(), H5P_DEFAULT),
                            "creating dataset " + dataset_path),
                    H5Dclose);
+  // A step without any particle has empty datasets: HDF5 gives an empty contiguous dataset no
+  // storage, and a write to it fails even with nothing selected. Every rank knows the total.
+  if (open_->particle_total == 0) return;
   checked(H5Dwrite(dataset.get(), H5T_NATIVE_DOUBLE, memory_space.get(), file_space.get(),
                    open_->transfer.get(), count > 0 ? values : &no_values),
           "writing dataset " + dataset_path);

@@ -20,6 +20,11 @@ namespace cfdmpm {
 /// A path that exists but is not a directory, or cannot be created, throws InputError too.
 void prepareOutputDirectory(MPI_Comm comm, const std::string& directory, bool overwrite);
 
+/// What prepareOutputDirectory would refuse, found without creating or removing anything (for
+/// `cfdmpm --check`); collective like it. A missing directory passes when its nearest existing
+/// parent is a writable directory.
+void checkOutputDirectory(MPI_Comm comm, const std::string& directory, bool overwrite);
+
 /// True for the names of files cfdmpm writes into an output directory: *.h5, *.xmf, *.csv, *.tmp.
 bool isOutputFile(const std::string& file_name);
 

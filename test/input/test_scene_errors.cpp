@@ -373,7 +373,7 @@ TEST_F(SceneTest, UnknownOutputFieldListsAllowedOnes)
 {
   const std::string message = errorOf(replaced(kFullScene, "fields: [velocity, pressure, particle_stress]", "fields: [velocity, presure]"));
   expectMentions(message, {"cfdmpm.output.fields", "got '[velocity, presure]'", "'presure' is not allowed",
-                           "volume_fraction, density, velocity, temperature, pressure, specific_volume, sound_speed, "
+                           "volume_fraction, density, velocity, temperature, pressure, specific_volume, "
                            "particle_velocity, particle_stress, plastic_strain, particle_material"});
 }
 

@@ -269,3 +269,45 @@ TEST(ParticleOutput, ParticleCountMustNotChangeWithinAStep)
 
 }  // namespace
 }  // namespace cfdmpm
+
+namespace cfdmpm {
+namespace {
+
+using namespace io_test;
+
+// A step in which no rank has a particle (every solid region left empty, say) still writes its
+// particle fields: /particles with count 0 and empty datasets, and the cell fields of the step.
+TEST(ParticleOutput, AStepWithoutAnyParticleWritesEmptyDatasets)
+{
+  const std::string directory = freshDirectory("no_particles");
+  const std::array<long long, 3> cells{4, 3, 1}, nodes{5, 4, 1};
+  auto whole = [](const std::array<long long, 3>& count) {
+    return std::array<std::vector<long long>, 3>{{{0, count[0]}, {0, count[1]}, {0, count[2]}}};
+  };
+  const std::array<double, 3> origin{0, 0, 0}, spacing{0.5, 0.5, 1.0};
+  const OutputLayout cell_layout = splitLayout(2, cells, origin, spacing, whole(cells), Ownership::AllOnRankZero);
+  const OutputLayout node_layout = splitLayout(2, nodes, origin, spacing, whole(nodes), Ownership::AllOnRankZero);
+  Hdf5Writer hdf5(MPI_COMM_WORLD, directory, "run", cell_layout, node_layout);
+  XdmfWriter xdmf(MPI_COMM_WORLD, directory, "run", cell_layout, node_layout);
+  hdf5.beginStep(0, 0.0);
+  const std::vector<double> pressure = knownBuffer(cell_layout, 1, 1);
+  hdf5.writeScalar(OutputLocation::Cells, "pressure", pressure.data(), pressure.size());
+  hdf5.writeParticleVector("position", nullptr, 0, 2);
+  hdf5.writeParticleScalar("material", nullptr, 0);
+  const WrittenStep step = hdf5.endStep();
+  xdmf.addStep(step);
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (rank() != 0) return;
+  hid_t file = H5Fopen((directory + "/" + step.file).c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0) << step.file;
+  EXPECT_EQ(readAttribute<long long>(file, "/particles", "count", H5T_NATIVE_LLONG, 1)[0], 0);
+  EXPECT_EQ(datasetDimsInFile(file, "/particles/position"), (std::vector<long long>{0, 2}));
+  EXPECT_EQ(datasetDimsInFile(file, "/particles/material"), (std::vector<long long>{0}));
+  EXPECT_EQ(readDataset(file, "/cells/pressure"), pressure);
+  H5Fclose(file);
+  // No particle grid in the time series: ParaView has nothing to draw.
+  EXPECT_EQ(readText(directory + "/run.xmf").find("Polyvertex"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace cfdmpm

@@ -6,7 +6,6 @@
 // usage: [mpiexec -n N] bench_mpmice [steps [dt]]     (defaults 200 steps of 2e-5 s)
 #include "coupled_support.hpp"
 
-#include <Teuchos_TimeMonitor.hpp>
 #include <Tpetra_Core.hpp>
 
 #include <iomanip>
@@ -15,12 +14,6 @@
 using namespace cfdmpm;
 
 namespace {
-
-double timerSeconds(const std::string& name)
-{
-  const auto timer = Teuchos::TimeMonitor::lookupCounter(name);
-  return timer.is_null() ? 0.0 : timer->totalElapsedTime();
-}
 
 /// The scene without its solid materials and their regions: the fluids alone on the same grid.
 Scene fluidsOnly(const Scene& scene)
@@ -46,7 +39,7 @@ std::map<std::string, double> measure(const Scene& scene, int steps, double dt, 
   };
   for (int s = 0; s < 5; ++s) advance();
   std::map<std::string, double> before, spent;
-  for (const char* phase : MpmIceStep<2>::kPhases) before[phase] = timerSeconds(std::string("mpmice: ") + phase);
+  for (const char* phase : MpmIceStep<2>::kPhases) before[phase] = run.stepper.phaseSeconds(phase);
   long long outer = 0;
   for (int s = 0; s < steps; ++s) {
     advance();
@@ -54,7 +47,7 @@ std::map<std::string, double> measure(const Scene& scene, int steps, double dt, 
   }
   outer_per_step = double(outer) / steps;
   for (const char* phase : MpmIceStep<2>::kPhases) {
-    double local = timerSeconds(std::string("mpmice: ") + phase) - before[phase], slowest = 0;
+    double local = run.stepper.phaseSeconds(phase) - before[phase], slowest = 0;
     Teuchos::reduceAll(*comm, Teuchos::REDUCE_MAX, local, Teuchos::outArg(slowest));
     spent[phase] = slowest;
   }

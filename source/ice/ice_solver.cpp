@@ -45,11 +45,10 @@ KOKKOS_INLINE_FUNCTION double followMixtureVelocity(int n, const Density& rho, c
   return mass;
 }
 
-// A rigid material moves at its prescribed velocity whatever the forces on it: in the exchange it
-// enters with its specific volume divided (its mass density multiplied) by this factor, i.e. with
-// an inertia so large that the other materials relax to its velocity and it keeps its own. At the
-// same time its face specific volume (the pressure equation's coefficient) vanishes, so faces where
-// it is present carry no pressure-driven flow: a cell filled by the body acts as a wall.
+// A rigid material moves at its prescribed velocity whatever the forces on it: in the cell-centred
+// exchange it enters with its specific volume divided (its mass density multiplied) by this factor,
+// i.e. with an inertia so large that the other materials relax to its velocity and it keeps its
+// own. (On faces it takes no part in the exchange; faceVelocities closes its share of the face.)
 constexpr double kRigidInertia = 1e30;
 
 // The exchange coefficients between every pair: the scene's K between fluids and between a fluid
@@ -615,21 +614,19 @@ void IceSolver<Dim>::exchangePhase(CellState<Dim>& state, double dt, IceStepRepo
         "ice::exchangeCC", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
         KOKKOS_LAMBDA(const LocalOrdinal c) {
           const int nm = N > 0 ? N : n;
-          ice::MaterialArray<double> r{}, t{}, s{};
+          ice::MaterialArray<double> r{}, t{}, s{}, weight{};  // weight: r, a rigid body's scaled up
           ice::MaterialArray<Kokkos::Array<double, Dim>> vel{};
           for (int m = 0; m < nm; ++m) {
-            r[m] = rho(c, m), t[m] = theta(c, m), s[m] = v(c, m);
-            if (roles.rigid[m]) r[m] *= kRigidInertia, s[m] /= kRigidInertia;
+            r[m] = rho(c, m), t[m] = theta(c, m), s[m] = v(c, m), weight[m] = r[m];
+            if (roles.rigid[m]) weight[m] *= kRigidInertia, s[m] /= kRigidInertia;
             for (int d = 0; d < Dim; ++d) vel[m][d] = un(c, m * Dim + d);
           }
-          const ice::ExchangeStatus status = ice::exchangeMomentumCC<Dim, N>(nm, dt, K, r, t, s, vel);
+          const ice::ExchangeStatus status = ice::exchangeMomentumCC<Dim, N>(nm, dt, K, weight, t, s, vel);
           if (status != ice::ExchangeStatus::Ok) {
             Kokkos::atomic_add(&bad(), 1);
             const long long gid = ijk(c, 0) + nx * (ijk(c, 1) + (Dim == 3 ? ny * ijk(c, 2) : 0));
             Kokkos::atomic_fetch_min(&first(), gid);
           }
-          for (int m = 0; m < nm; ++m)
-            if (roles.rigid[m]) r[m] /= kRigidInertia;
           followMixtureVelocity<Dim>(
               nm, [&](int m) { return r[m]; }, [&](int m, int d) -> double& { return vel[m][d]; });
           for (int m = 0; m < nm; ++m)

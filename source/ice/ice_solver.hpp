@@ -109,7 +109,7 @@ class IceSolver {
   /// update); faces corrected. Throws if a linear solve fails.
   void pressurePhase(CellState<Dim>& state, double dt, IceStepReport& report);
   /// [6] Momentum sources: face pressure, the pressure force on every material (θ V ∇p_f), and on
-  /// fluids viscosity and gravity; gives the Lagrangian velocities (lagrangianVelocity()).
+  /// fluids viscosity and gravity; gives the Lagrangian velocities, which exchangePhase takes.
   void momentumSourcePhase(CellState<Dim>& state, double dt);
   /// [8] Lagrangian specific volume, implicit cell-centred momentum exchange between all
   /// materials, and energy (unless isothermal); the exchanged velocities become the state's.
@@ -117,9 +117,6 @@ class IceSolver {
   /// [10] Advection of the fluids (solids are Lagrangian) and the cell closure θ = ρ v.
   void advectionPhase(CellState<Dim>& state, double dt, IceStepReport& report);
 
-  /// Velocities after the momentum sources, before the exchange (valid between
-  /// momentumSourcePhase and exchangePhase; afterwards work space).
-  const Field<Dim>& lagrangianVelocity() const { return new_velocity_; }
   const MaterialRoles& roles() const { return roles_; }
   /// The pressure about which the solids' equation of state is taken in each cell (the pore pressure
   /// of still fluid there; default: initial_state.pressure everywhere). The coupled step sets it to

@@ -212,8 +212,8 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
     if (stepper.fluidsMove() && !step_report.ice.converged && root && ++unconverged_warnings <= 10)
       std::cout << "  warning: step " << step + 1 << ": the pressure's outer iteration stopped at residual "
                 << step_report.ice.outer_residual << " after " << step_report.ice.outer_iterations
-                << " iterations (ice.outer_tolerance " << IceSettings::fromScene(scene).outer_tolerance
-                << ", ice.max_outer_iterations " << IceSettings::fromScene(scene).max_outer_iterations
+                << " iterations (ice.outer_tolerance " << stepper.fluids()->settings().outer_tolerance
+                << ", ice.max_outer_iterations " << stepper.fluids()->settings().max_outer_iterations
                 << "); column pressure_converged of the CSV marks such steps"
                 << (unconverged_warnings == 10 ? " (further warnings suppressed)" : "") << "\n";
     t = (t + dt > next_output - eps) ? next_output : t + dt;

@@ -326,8 +326,18 @@ QuantityColumns<Dim, View, kMaxFields> quantityColumns(const std::vector<FieldPo
 }  // namespace
 
 template <int Dim>
+const typename Advector<Dim>::WorkView& Advector<Dim>::slabDensities(const FaceField<Dim>& face_velocity, double dt,
+                                                                     const Field<Dim>& mass)
+{
+  if (slab_density_.extent(0) == 0)
+    slab_density_ = WorkView("advection slab density", layout_->overlapCells(), 2 * Dim, materials_);
+  reconstruct(face_velocity, dt, mass, {}, true);
+  return slab_density_;
+}
+
+template <int Dim>
 LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass,
-                                          const std::vector<Field<Dim>*>& mass_specific)
+                                          const std::vector<Field<Dim>*>& mass_specific, bool slab_densities)
 {
   const Slabs<Dim> slabs(face_velocity, *layout_, dt, options_.transverse_correction);
   const CellStencil<Dim> stencil(*layout_, block_);
@@ -343,6 +353,7 @@ LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, d
   const auto outflow_mass = outflow_mass_;
   const auto outflow_value = outflow_value_;
   const auto bounds = bounds_;
+  const auto slab_density = slab_density_;
   const int materials = materials_;
   const LocalOrdinal owned = layout_->ownedCells();
 
@@ -372,6 +383,7 @@ LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, d
             bool inflow_possible = false;
             for (int f = 0; f < 2 * Dim; ++f) {
               outflow_mass(c, f, m) = 0.0;
+              if (slab_densities) slab_density(c, f, m) = 0.0;
               const LocalOrdinal n = local.neighbour[f];
               inflow_possible = inflow_possible || (n >= 0 && M(n, m) != 0.0);
             }
@@ -412,6 +424,7 @@ LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, d
           for (int f = 0; f < 2 * Dim; ++f) {
             slab_mass[f] = fraction[f] * (value + phi * slope[f]);
             outflow_mass(c, f, m) = slab_mass[f];
+            if (slab_densities) slab_density(c, f, m) = value + phi * slope[f];
             left -= slab_mass[f];
           }
           if (!(left > 0)) left = 0.0;

@@ -76,9 +76,17 @@ class Advector {
   AdvectionStatus advect(FaceField<Dim>& face_velocity, double dt, Field<Dim>& mass,
                          const std::vector<Field<Dim>*>& mass_specific);
 
+  /// The limited mass profile of every cell (owned and ghost) evaluated in the outflow slab of each
+  /// of its faces for these face velocities, i.e. the bulk density that advect() would move through
+  /// the face per slab volume: (local cell, face f = 2 d + side, material); 0 in a cell without the
+  /// material. Where nothing leaves through a face, the profile's value at the face. The pressure
+  /// equation takes its volume fluxes from it when solids share the cells, so that the volume it
+  /// makes room for is the volume the advection brings. Needs current ghosts of both inputs.
+  using WorkView = Kokkos::View<double***, MemorySpace>;  // (local cell, face, material)
+  const WorkView& slabDensities(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass);
+
   int materials() const { return materials_; }
 
-  using WorkView = Kokkos::View<double***, MemorySpace>;  // (local cell, face, material)
 
  /// At most this many mass-specific fields per advect() call (each of any width).
   static constexpr int kMaxFields = 8;
@@ -86,7 +94,7 @@ class Advector {
  private:
   /// The slab pass; returns this rank's largest outflow fraction and where it occurs.
   LargestOutflow reconstruct(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass,
-                             const std::vector<Field<Dim>*>& mass_specific);
+                             const std::vector<Field<Dim>*>& mass_specific, bool slab_densities = false);
   AdvectionStatus outfluxStatus(const LargestOutflow& local) const;
   void update(Field<Dim>& mass, const std::vector<Field<Dim>*>& mass_specific);
 
@@ -99,6 +107,8 @@ class Advector {
   // Per local cell (owned and ghost), face f = 2 d + side and material: the mass leaving the cell
   // through f in this step (>= 0).
   WorkView outflow_mass_;
+  // Per local cell, face and material: the profile's value in the face's slab (slabDensities).
+  WorkView slab_density_;
   // Per local cell, face and quantity column (all fields' columns side by side): the value of the
   // quantity in the outflow slab; and per local cell and column, the block bounds [lo, hi] of the
   // quantity (computed once for the limiter, reused by the update's final bound).

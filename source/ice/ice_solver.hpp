@@ -56,6 +56,11 @@ struct IceStepReport {
   double outer_residual = 0;      // max |rhs| / V at the end (a fraction of the cell volume)
   bool converged = true;          // the outer iteration reached outer_tolerance
   int equilibration_failures = 0; // cells whose equilibration pressure did not converge
+  // Largest |p_eq − p| over the cells (Pa): how far the equilibration moved the pressure that the
+  // previous step ended with. The previous pressure equation made room for the volumes it foresaw;
+  // a jump is a volume that arrived unforeseen (by advection or by the particles) divided by the
+  // cell's compressibility Σθκ.
+  double equilibration_jump = 0;
   int exchange_failures = 0;      // cells or faces whose exchange gave a value that is not finite
   long long first_failed_cell = -1;  // global id of the lowest such cell (either kind), or -1
   double max_outflux_fraction = 0;
@@ -123,6 +128,22 @@ class IceSolver {
   /// the initial state's pressure, the hydrostatic pressure of the fluids that the solids displace.
   void setSolidReferencePressure(const Field<Dim>& pressure);
 
+  /// Each solid's share of every cell face on its two sides (columns 2 m: the layer just below the
+  /// lower face of a cell, 2 m + 1: just above it; owned and ghost cells), which the coupled step sets
+  /// from the particles before the face velocities. A solid's volume crosses a face with the share
+  /// upstream of it (not with the upstream cell's volume fraction: a front inside a cell has not
+  /// reached its face), couples to the fluids on a face by its shares there, and a rigid solid closes
+  /// the larger of its two shares. Fluids use their cells' volume fractions. Zero until set.
+  FaceField<Dim>& solidFaceShares() { return solid_face_share_; }
+  /// Each solid's change of volume fraction in every cell over the step if its particles moved with
+  /// the velocity they have before the fluid pressure acts (columns: materials; owned cells), set by
+  /// the coupled step. The pressure equation counts a solid's volume flux as this change plus, on
+  /// each face, u_f s(u_f) − u_k s(u_k): the volume its face velocity u_f (after pressure and
+  /// exchange) carries minus what the particles' own motion u_k carries, s(u) the share upwind of u.
+  /// A solid's volume moves as its particles move, which near a contact or along a staircase
+  /// surface is not the cell-averaged velocity times a face share.
+  Field<Dim>& solidVolumeChange() { return solid_volume_change_; }
+
   /// The largest stable Δt for the state (convective CFL and viscous limits), at most
   /// growth × previous_dt and within [dt_min, dt_max].
   TimeStepLimit stableTimeStep(const CellState<Dim>& state, double previous_dt) const;
@@ -142,6 +163,7 @@ class IceSolver {
  private:
   void faceVelocities(const CellState<Dim>& state, double dt);
   double pressureRightHandSide(CellState<Dim>& state, double dt, bool after_solve);
+  void fluidFaceFractions(const CellState<Dim>& state, double dt);
   void energy(CellState<Dim>& state, const Field<Dim>& old_specific_volume, double dt);
 
   Scene scene_;
@@ -167,6 +189,10 @@ class IceSolver {
   FaceField<Dim> corrected_face_velocity_;  // work array of the pressure correction
   FaceField<Dim> face_specific_volume_; // per material, after the face exchange
   FaceField<Dim> face_beta_;            // Σ θ_f v_f
+  FaceField<Dim> solid_face_share_;     // solidFaceShares()
+  Field<Dim> solid_volume_change_;      // solidVolumeChange()
+  FaceField<Dim> solid_kinematic_velocity_;  // a solid's face velocity before pressure and exchange
+  FaceField<Dim> fluid_face_fraction_;  // with solids: a fluid's volume fraction crossing a face (columns 2 m, 2 m + 1: donor below, above)
   Field<Dim> new_velocity_;             // Lagrangian velocities between sources and exchange
   Field<Dim> old_specific_volume_;      // v before the Lagrangian update (for the p dv work)
   Field<Dim> solid_reference_pressure_; // p_ref of the solids' equation of state per cell (Pa)

@@ -585,17 +585,48 @@ struct CellOverlap {
       for (int d = 0; d < 3; ++d) cell[count][d] = ijk[d];
       share[count++] = w;
     }
+    for (int d = 0; d < Dim; ++d) first_[d] = first[d], span_[d] = span[d], lower_share_[d] = lower_share[d];
   }
+
+  /// The cells of the box's overlap that share one index (`along`) in direction d: the other
+  /// directions' cells and shares, as for the whole box. Visits f(ijk, share) with ijk[d] unset.
+  template <class F>
+  KOKKOS_INLINE_FUNCTION void acrossDirection(int d, F&& f) const
+  {
+    for (int corner = 0; corner < kMaxCells; ++corner) {
+      if ((corner >> d) & 1) continue;
+      double w = 1.0;
+      bool used = true;
+      long long ijk[3] = {0, 0, 0};
+      for (int e = 0; e < Dim; ++e) {
+        if (e == d) continue;
+        const int upper = (corner >> e) & 1;
+        if (upper && span_[e] == 1) used = false;
+        ijk[e] = first_[e] + upper;
+        w *= upper ? 1.0 - lower_share_[e] : lower_share_[e];
+      }
+      if (used) f(ijk, w);
+    }
+  }
+
+ private:
+  long long first_[Dim];
+  int span_[Dim];
+  double lower_share_[Dim];
 };
+
+/// Width of the layers on either side of a cell face in which a solid's share of the face is
+/// measured, in cells (see MpmSolver::particlesToCells).
+constexpr double kFaceLayer = 0.125;
 
 }  // namespace
 
 template <int Dim>
-void MpmSolver<Dim>::particlesToCells(Field<Dim>& sums)
+void MpmSolver<Dim>::particlesToCells(Field<Dim>& sums, double dt)
 {
   withShapeFunction([&](auto kernel) {
     using K = decltype(kernel);
-    particlesToCellsWith<K>(sums);
+    particlesToCellsWith<K>(sums, dt);
   });
 }
 
@@ -610,7 +641,7 @@ void MpmSolver<Dim>::addCellVelocityChange(const Field<Dim>& change)
 
 template <int Dim>
 template <class Kernel>
-void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums)
+void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt)
 {
   const int nm = int(materials_.size());
   if (sums.columns() != cellColumns(nm))
@@ -632,6 +663,7 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums)
   long long count[Dim];
   for (int d = 0; d < Dim; ++d)
     origin[d] = grid.lower()[d], spacing[d] = grid.spacing()[d], count[d] = grid.cells()[d];
+  const double cell_volume = grid.cellVolume();
   const auto scatter = KOKKOS_LAMBDA(const int p)
   {
     const int m = material(p);
@@ -659,6 +691,34 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums)
       out(c, m) += w * mp;
       out(c, nm + m) += w * Vp;
       for (int d = 0; d < Dim; ++d) out(c, 2 * nm + m * Dim + d) += w * mp * velocity[d];
+    }
+    double moved[Dim];
+    for (int d = 0; d < Dim; ++d) moved[d] = xp[d] + dt * velocity[d];
+    const CellOverlap<Dim> predicted(moved, lp, origin, spacing, count);
+    for (int k = 0; k < predicted.count; ++k) {
+      const LocalOrdinal c = cells(predicted.cell[k][0], predicted.cell[k][1], predicted.cell[k][2]);
+      if (c >= 0) out(c, predictedVolumeColumn(nm, m)) += predicted.share[k] * Vp;
+    }
+    // Face shares: the particle's volume in the layers of width kFaceLayer cells just below and
+    // just above each interior face its box reaches, per volume of the layer.
+    for (int d = 0; d < Dim; ++d) {
+      const double lo = (xp[d] - lp[d] - origin[d]) / spacing[d], hi = (xp[d] + lp[d] - origin[d]) / spacing[d];
+      const double per_length = Vp / ((hi - lo) * kFaceLayer * cell_volume);
+      const long long first_face = -(long long)math::floor(kFaceLayer - lo), last_face = (long long)math::floor(hi + kFaceLayer);
+      for (long long f = first_face; f <= last_face; ++f) {
+        if (f < 1 || f > count[d] - 1) continue;  // domain faces are walls
+        const double below = math::max(0.0, math::min(hi, double(f)) - math::max(lo, f - kFaceLayer));
+        const double above = math::max(0.0, math::min(hi, f + kFaceLayer) - math::max(lo, double(f)));
+        if (below <= 0 && above <= 0) continue;
+        overlap.acrossDirection(d, [&](long long ijk[3], double w) {
+          ijk[d] = f;
+          const LocalOrdinal c = cells(ijk[0], ijk[1], ijk[2]);
+          if (c < 0) return;
+          const int column = faceColumn(nm, m, d, 0);
+          out(c, column) += w * per_length * below;
+          out(c, column + 1) += w * per_length * above;
+        });
+      }
     }
   };
   // Each particle adds into the cells around its own, within the reach of its node stencil: the

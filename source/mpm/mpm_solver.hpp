@@ -116,15 +116,32 @@ class MpmSolver {
 
   // --- transfers of the coupled step (mpmice/): particles <-> cells ------------------------------
   /// Columns of a cell field for particlesToCells / addCellVelocityChange: per MPM material a,
-  /// mass (column a), volume (materials + a) and momentum or velocity change (2 materials + a Dim + d).
-  static int cellColumns(int materials) { return materials * (2 + Dim); }
+  /// mass (column a), volume (materials + a) and momentum or velocity change (2 materials + a Dim + d),
+  /// then the face shares of particlesToCells (faceColumn).
+  static int cellColumns(int materials) { return materials * (3 + 3 * Dim); }
+  /// Column of material a's volume in a cell with every particle moved by Δt ṽ_p (particlesToCells).
+  KOKKOS_INLINE_FUNCTION static int predictedVolumeColumn(int materials, int a) { return materials * (2 + 3 * Dim) + a; }
+  /// Column of material a's share of the lower face of a cell in direction d, in the layer below the
+  /// face (side 0) or above it (side 1).
+  KOKKOS_INLINE_FUNCTION static int faceColumn(int materials, int a, int d, int side)
+  {
+    return materials * (2 + Dim) + 2 * (a * Dim + d) + side;
+  }
   /// Each particle's mass m_p, volume V_p and momentum m_p ṽ_p into the cells that its GIMP domain
   /// (the box of half-width l_p about it) overlaps, in proportion to the overlap (the part beyond a
   /// domain face goes to the boundary cell), so that a body aligned with the cells fills them exactly
   /// and the cell values change smoothly as particles cross cell faces. ṽ_p = Σ_i w_ip v*_i, the
-  /// grid velocity after integrateGrid (a rigid particle's: its prescribed velocity). Summed across
-  /// ranks: the owned cells are complete, and so are the ghosts.
-  void particlesToCells(Field<Dim>& sums);
+  /// grid velocity after integrateGrid (a rigid particle's: its prescribed velocity). And each
+  /// material's share of every interior cell face, on each side: its volume in the layer of width
+  /// h/8 just below (above) the face, per volume of the layer. A face inside a body is covered (1),
+  /// the face on a body's surface is covered on the body's side only, and a face that a front has
+  /// not reached is not covered, however full the cell behind it: what crosses a face in a step is
+  /// the share of the layer upstream of it (times u Δt), not the upstream cell's volume fraction.
+  /// Summed across ranks: the owned cells are complete, and so are the ghosts.
+  /// With dt > 0 also the volume each material would have in every cell if each particle moved by
+  /// Δt ṽ_p (predictedVolumeColumn): how the solids' volumes move in a step before the fluid
+  /// pressure acts on them.
+  void particlesToCells(Field<Dim>& sums, double dt = 0.0);
   /// Adds cell velocity changes Δu_c (columns 2 materials + a Dim + d; owned and ghost cells) to the
   /// grid velocity v*: a particle takes Δv_p = Σ_c φ_pc Δu_c with the overlap shares of
   /// particlesToCells, its momentum m_p Δv_p goes to the nodes by its weights, v*_i += Δ(mv)_i / m_i;
@@ -177,7 +194,7 @@ class MpmSolver {
   template <class Kernel>
   void gridToParticlesWith(double dt);
   template <class Kernel>
-  void particlesToCellsWith(Field<Dim>& sums);
+  void particlesToCellsWith(Field<Dim>& sums, double dt);
   template <class Kernel>
   void addCellVelocityChangeWith(const Field<Dim>& change);
   /// f(p) for every particle, for kernels that add into node arrays: in index order on one thread;

@@ -44,7 +44,7 @@ MpmIceStep<Dim>::MpmIceStep(const Scene& scene, std::shared_ptr<const Layout<Dim
                                                    "solid cell velocity");
     mpm_->particlesToGrid();
     mpm_->integrateGrid(0.0);  // v* = v: the particles' velocities on the grid, walls applied
-    cellsFromParticles(state);
+    cellsFromParticles(state, 0.0);
     fillAroundSolids(scene, densityFunctions(scene), state);
   }
   if (ice_) {
@@ -73,7 +73,7 @@ CoupledStepReport MpmIceStep<Dim>::step(CellState<Dim>& state, double dt)
   // 2. The solids' mass, volume and velocity v* in every cell.
   if (ice_ && mpm_) {
     Teuchos::TimeMonitor phase(*timers_.at("2 particles to cells"));
-    cellsFromParticles(state);
+    cellsFromParticles(state, dt);
   }
   if (ice_) {
     // 3-6. Equilibration pressure, face velocities and face exchange, implicit pressure, momentum
@@ -122,9 +122,9 @@ CoupledStepReport MpmIceStep<Dim>::step(CellState<Dim>& state, double dt)
 }
 
 template <int Dim>
-void MpmIceStep<Dim>::cellsFromParticles(CellState<Dim>& state)
+void MpmIceStep<Dim>::cellsFromParticles(CellState<Dim>& state, double dt)
 {
-  mpm_->particlesToCells(*cell_sums_);
+  mpm_->particlesToCells(*cell_sums_, dt);
   const int nm = int(mpm_->materials().size());
   Kokkos::Array<int, ice::kMaxMaterials> scene_index{};
   for (int a = 0; a < nm; ++a) scene_index[a] = mpm_->materials()[a].scene_index;
@@ -134,6 +134,9 @@ void MpmIceStep<Dim>::cellsFromParticles(CellState<Dim>& state)
   auto theta = state.volume_fraction.view();
   auto u = state.velocity.view();
   auto solid_u = solid_velocity_->view();
+  auto change = ice_->solidVolumeChange().view();
+  typename Field<Dim>::View face_share[3];
+  for (int d = 0; d < Dim; ++d) face_share[d] = ice_->solidFaceShares().direction(d).view();
   // The sums are complete on the ghosts as well, so every local cell is set without a halo exchange.
   Kokkos::parallel_for(
       "mpmice::cellsFromParticles", Kokkos::RangePolicy<ExecutionSpace>(0, state.density.overlapCount()),
@@ -145,6 +148,10 @@ void MpmIceStep<Dim>::cellsFromParticles(CellState<Dim>& state)
         const double scale = solid_volume > volume ? volume / solid_volume : 1.0;
         for (int a = 0; a < nm; ++a) {
           const int m = scene_index[a];
+          for (int d = 0; d < Dim; ++d)
+            for (int side = 0; side < 2; ++side)
+              face_share[d](c, 2 * m + side) = sums(c, mpm::MpmSolver<Dim>::faceColumn(nm, a, d, side));
+          change(c, m) = (sums(c, mpm::MpmSolver<Dim>::predictedVolumeColumn(nm, a)) - sums(c, nm + a)) / volume;
           const double mass = sums(c, a);
           rho(c, m) = mass / volume;
           theta(c, m) = scale * sums(c, nm + a) / volume;

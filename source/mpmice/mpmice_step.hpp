@@ -65,7 +65,7 @@ class MpmIceStep {
 
  private:
   /// The solids' columns of the state (mass density, volume fraction, velocity) from the particles.
-  void cellsFromParticles(CellState<Dim>& state);
+  void cellsFromParticles(CellState<Dim>& state, double dt);
   /// The solids' cell velocity change since cellsFromParticles, in the particle solver's columns.
   void velocityChange(const CellState<Dim>& state);
 

@@ -113,7 +113,7 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
     physics_columns = {"outer_iterations", "pressure_iterations", "outer_residual", "max_outflux_fraction"};
     // With particles, the solids' columns are theirs (exact masses), not the cells'.
     for (const std::string& c : conservedColumns<Dim>(scene, stepper.hasParticles())) physics_columns.push_back(c);
-    physics_columns.insert(physics_columns.end(), {"equilibration_failures", "exchange_failures", "pressure_converged"});
+    physics_columns.insert(physics_columns.end(), {"equilibration_failures", "equilibration_jump", "exchange_failures", "pressure_converged"});
   }
   if (stepper.hasParticles()) {
     physics_columns.push_back("particles");
@@ -131,7 +131,7 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
       for (int m = 0; m < state.materials; ++m)
         if (!stepper.hasParticles() || scene.materials[m].kind == "fluid")
           for (int k = 0; k < Dim + 2; ++k) row.emplace_back(sums[m * (Dim + 2) + k]);
-      row.insert(row.end(), {CsvValue(r.equilibration_failures), CsvValue(r.exchange_failures),
+      row.insert(row.end(), {CsvValue(r.equilibration_failures), CsvValue(r.equilibration_jump), CsvValue(r.exchange_failures),
                              CsvValue(r.converged ? 1 : 0)});
     }
     if (const mpm::MpmSolver<Dim>* particles = stepper.particles()) {

@@ -261,7 +261,8 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
       limit.limiter += "+output";
     }
     step_report = stepper.step(state, dt);
-    if (stepper.fluidsMove() && !step_report.ice.converged && root && ++clock.unconverged_warnings <= 10)
+    // Counted on every rank (the report is the same on all): a checkpoint stores the count.
+    if (stepper.fluidsMove() && !step_report.ice.converged && ++clock.unconverged_warnings <= 10 && root)
       std::cout << "  warning: step " << step + 1 << ": the pressure's outer iteration stopped at residual "
                 << step_report.ice.outer_residual << " after " << step_report.ice.outer_iterations
                 << " iterations (ice.outer_tolerance " << stepper.fluids()->settings().outer_tolerance

@@ -81,7 +81,13 @@ CheckpointHeader readCheckpointHeader(MPI_Comm comm, const std::string& path)
     throw InputError("checkpoint '" + path + "': not a cfdmpm checkpoint (no attribute format = '" + kFormat + "')");
   CheckpointHeader header;
   header.path = path;
-  header.output_directory = fs::path(path).parent_path().parent_path().string();
+  // The run goes on in the output directory the checkpoint belongs to; a checkpoint moved out of
+  // its checkpoints/ folder has none.
+  const fs::path folder = fs::path(path).parent_path();
+  if (folder.filename() != "checkpoints")
+    throw InputError("checkpoint '" + path + "': not in the checkpoints/ folder of an output directory, so the "
+                     "run has nowhere to go on; put it in <output directory>/checkpoints/ and restart from there");
+  header.output_directory = folder.parent_path().string();
   if (header.output_directory.empty()) header.output_directory = ".";
   header.run_name = in.attributeText("run_name");
   header.scene_path = in.attributeText("scene_path");

@@ -36,9 +36,13 @@ expect truncated "checkpoint 'truncated.h5': not a readable HDF5 file" -- --rest
 printf 'not HDF5\n' > "$work/text.h5"
 expect not_hdf5 "checkpoint 'text.h5': not a readable HDF5 file" -- --restart text.h5
 expect step_file "checkpoint 'out/scene_000000.h5': not a cfdmpm checkpoint" -- --restart out/scene_000000.h5
+cp "$work/out/checkpoints/$checkpoint" "$work/moved.h5"
+expect moved "checkpoint 'moved.h5': not in the checkpoints/ folder of an output directory" -- --restart moved.h5
+mkdir -p "$work/copy/checkpoints"
 cp "$work/out/checkpoints/$checkpoint" "$work/no-density.h5"
 "$PYTHON" -c "import h5py, sys; del h5py.File(sys.argv[1], 'r+')['cells/state/density']" "$work/no-density.h5"
-expect missing_field "checkpoint 'no-density.h5': no dataset /cells/state/density" -- --restart no-density.h5
+mv "$work/no-density.h5" "$work/copy/checkpoints/"
+expect missing_field "checkpoint 'copy/checkpoints/no-density.h5': no dataset /cells/state/density" -- --restart copy/checkpoints/no-density.h5
 sed -e "s|cells: \[50, 20\]|cells: [40, 20]|" "$work/scene.yaml" > "$work/other-grid.yaml"
 expect other_grid "does not fit the checkpoint" -- --restart out other-grid.yaml
 expect with_check "--check and --restart do not go together" -- --check --restart out

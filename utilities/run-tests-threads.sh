@@ -29,4 +29,4 @@ source "$root/utilities/mpi-env.sh"
 export OMP_NUM_THREADS=${OMP_NUM_THREADS:-2} OMP_PROC_BIND=false OMP_WAIT_POLICY=passive
 export OMPI_MCA_hwloc_base_binding_policy=none
 cd "$build"
-ctest --output-on-failure -LE "bench|validation" -j 1 "$@"
+ctest --output-on-failure -j 1 "$@"

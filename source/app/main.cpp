@@ -2,6 +2,8 @@
 #include "input/parameter_rule.hpp"
 #include "input/scene.hpp"
 #include "input/scene_checks.hpp"
+#include "common/mpi_comm.hpp"
+#include "mpmice/checkpoint.hpp"
 #include "mpmice/simulation.hpp"
 
 #include <Tpetra_Core.hpp>
@@ -18,6 +20,7 @@ namespace {
 const char* kUsage =
     "usage: cfdmpm [options] scene.yaml\n"
     "       mpiexec -n N cfdmpm [options] scene.yaml\n"
+    "       mpiexec -n N cfdmpm --restart <checkpoint file or output directory> [scene.yaml]\n"
     "\n"
     "Runs a debris-flow scene: fluids by a multi-material ICE method, solids by the Material Point\n"
     "Method, on one Cartesian grid. The scene file's keys are documented in doc/input.md.\n"
@@ -27,15 +30,26 @@ const char* kUsage =
     "  --check       validate the scene file and stop: every check a run makes before its first\n"
     "                step (run it under mpiexec -n N to check the patches for N ranks), and what\n"
     "                each region places\n"
+    "  --restart P   continue a run from a checkpoint (output.checkpoint_interval or\n"
+    "                output.checkpoint_wall_interval; doc/output.md): P is a checkpoint file or an\n"
+    "                output directory (its newest checkpoint in P/checkpoints/). The run goes on in\n"
+    "                the directory holding the checkpoint, with the scene stored in the checkpoint,\n"
+    "                or with scene.yaml when given (same grid and materials; e.g. a later\n"
+    "                time.end_time). Step files and CSV rows after the checkpoint are rewritten. On\n"
+    "                as many ranks as the first run the result is bit for bit that of a run that\n"
+    "                never stopped; on another number of ranks it agrees to round-off\n"
     "  --help        print this help\n"
     "  --version     print the version\n"
     "\n"
     "exit codes: 0 the run reached its end (or --check passed), 1 run-time failure, 2 bad input or\n"
-    "            bad command line, 3 stopped by SIGINT or SIGTERM before its end (the files written\n"
-    "            are complete; a second signal ends the program at once)\n";
+    "            bad command line (a missing or unreadable checkpoint too),\n"
+    "            3 stopped by SIGINT or SIGTERM before its end (the files written are complete, and\n"
+    "            with checkpoints on a last checkpoint is written; a second signal ends the program\n"
+    "            at once)\n";
 
 struct CommandLine {
   std::string scene;
+  std::string restart;  // checkpoint file or output directory
   cfdmpm::RunOptions options;
   bool check_only = false;
 };
@@ -89,6 +103,12 @@ int main(int argc, char** argv)
       command.options.overwrite = true;
     } else if (arg == "--check") {
       command.check_only = true;
+    } else if (arg == "--restart") {
+      if (i + 1 >= argc || argv[i + 1][0] == '\0') {
+        std::cerr << "cfdmpm: error: --restart needs a checkpoint file or an output directory\n" << kUsage;
+        return 2;
+      }
+      command.restart = argv[++i];
     } else if (!arg.empty() && arg[0] == '-') {
       std::cerr << "cfdmpm: error: unknown option '" << arg << "'\n" << kUsage;
       return 2;
@@ -100,8 +120,12 @@ int main(int argc, char** argv)
       return 2;
     }
   }
-  if (command.scene.empty()) {
+  if (command.scene.empty() && command.restart.empty()) {
     std::cerr << "cfdmpm: error: no scene file given\n" << kUsage;
+    return 2;
+  }
+  if (!command.restart.empty() && command.check_only) {
+    std::cerr << "cfdmpm: error: --check and --restart do not go together\n" << kUsage;
     return 2;
   }
 
@@ -110,8 +134,26 @@ int main(int argc, char** argv)
   const auto comm = Tpetra::getDefaultComm();
   const bool root = comm->getRank() == 0;
   try {
-    // 3. Read and validate the scene on every rank; a bad file stops here, before any output.
-    const cfdmpm::Scene scene = cfdmpm::readScene(command.scene);
+    // 3. Read and validate the scene on every rank; a bad file stops here, before any output. A
+    //    restart takes the scene the checkpoint keeps, or the one given if it fits the checkpoint,
+    //    and goes on in the checkpoint's output directory.
+    cfdmpm::Scene scene;
+    if (command.restart.empty()) {
+      scene = cfdmpm::readScene(command.scene);
+    } else {
+      const std::string checkpoint = cfdmpm::findCheckpoint(command.restart);
+      const cfdmpm::CheckpointHeader header = cfdmpm::readCheckpointHeader(cfdmpm::rawMpiComm(comm), checkpoint);
+      const cfdmpm::Scene stored = cfdmpm::readSceneText(header.scene_text, header.scene_path);
+      scene = stored;
+      if (!command.scene.empty()) {
+        scene = cfdmpm::readScene(command.scene);
+        cfdmpm::checkRestartScene(scene, stored);
+      }
+      scene.output.directory = header.output_directory;
+      command.options.restart_checkpoint = checkpoint;
+      command.options.run_name = header.run_name;
+      command.options.overwrite = true;  // the directory holds the run being continued
+    }
     //    Then the set-up checks that depend on the ranks and the machine (memory, patches per
     //    rank, output directory), nothing created; the run makes them again as it sets up.
     cfdmpm::checkSetUp(scene, comm, command.options.overwrite);

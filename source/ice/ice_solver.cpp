@@ -984,6 +984,12 @@ TimeStepLimit IceSolver<Dim>::stableTimeStep(const CellState<Dim>& state, double
   return limit;
 }
 
+template <int Dim>
+void IceSolver<Dim>::restartPreconditionerSchedule()
+{
+  if (pressure_solver_) pressure_solver_->requestPreconditionerRebuild();
+}
+
 template class IceSolver<2>;
 template class IceSolver<3>;
 

@@ -127,6 +127,14 @@ class IceSolver {
   /// of still fluid there; default: initial_state.pressure everywhere). The coupled step sets it to
   /// the initial state's pressure, the hydrostatic pressure of the fluids that the solids displace.
   void setSolidReferencePressure(const Field<Dim>& pressure);
+  /// The solids' reference pressure per cell (Pa), set once at the start of a run; a checkpoint
+  /// keeps it.
+  const Field<Dim>& solidReferencePressure() const { return solid_reference_pressure_; }
+
+  /// The next pressure solve builds a fresh preconditioner (MueLu hierarchy). A checkpoint calls
+  /// it: the restarted run has no hierarchy to reuse, so the run that goes on builds one too, and
+  /// both continue from the same schedule.
+  void restartPreconditionerSchedule();
 
   /// Each solid's share of every cell face on its two sides (columns 2 m: the layer just below the
   /// lower face of a cell, 2 m + 1: just above it; owned and ghost cells), which the coupled step sets

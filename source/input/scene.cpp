@@ -773,6 +773,9 @@ OutputSpec readOutput(ParameterList& list)
   output.fields.assign(fields.begin(), fields.end());
   output.overwrite = list.get<bool>("overwrite");
   output.progress_interval = list.get<double>("progress_interval");
+  output.checkpoint_interval = list.get<double>("checkpoint_interval");
+  output.checkpoint_wall_interval = list.get<double>("checkpoint_wall_interval");
+  output.checkpoints_kept = list.get<int>("checkpoints_kept");
   if (output.directory.empty()) throw inputError(path + ".directory", "", "must name a directory");
   for (size_t i = 0; i < output.fields.size(); ++i) {
     if (std::find(output.fields.begin(), output.fields.begin() + i, output.fields[i]) != output.fields.begin() + i) {
@@ -794,13 +797,19 @@ int Scene::materialIndex(const std::string& name) const
 
 Scene readScene(const std::string& path)
 {
-  // 1. The file: readable, one top-level key `cfdmpm`, valid YAML.
-  const std::string text = screenText(readText(path), path);
+  return readSceneText(readText(path), path);
+}
+
+Scene readSceneText(const std::string& file_text, const std::string& path)
+{
+  // 1. The file: one top-level key `cfdmpm`, valid YAML.
+  const std::string text = screenText(file_text, path);
   refuseOtherTopLevelKeys(text, path);
   RCP<ParameterList> root = parseYaml(text, path);
 
   Scene scene;
   scene.path = path;
+  scene.text = file_text;
   scene.parameters = root;
   try {
     // 2. The top level: known sections of the right type, required ones present, optional ones added.

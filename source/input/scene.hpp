@@ -64,6 +64,9 @@ struct OutputSpec {
   std::vector<std::string> fields;
   bool overwrite = false;
   double progress_interval = 1.0;  // s of wall time between progress lines
+  double checkpoint_interval = 0;       // s of simulated time between checkpoints; 0 = none
+  double checkpoint_wall_interval = 0;  // s of wall-clock time between checkpoints; 0 = none
+  int checkpoints_kept = 2;             // the newest checkpoints kept; older ones are removed
 };
 
 struct InitialStateSpec {
@@ -86,6 +89,7 @@ struct MpmSpec {
 
 struct Scene {
   std::string path;
+  std::string text;  // the file as read (a checkpoint keeps it, so that a restart needs no scene file)
   std::string title;
   DomainSpec domain;
   std::vector<MaterialSpec> materials;  // in file order; a material's index is its position here
@@ -126,5 +130,9 @@ std::vector<std::string> boundaryFaces(int dimension);   // x-, x+, y-, y+ (, z-
 /// Reads and validates a scene file. Throws InputError (message: key, value, what is allowed) on
 /// any problem; nothing is written before it returns.
 Scene readScene(const std::string& path);
+
+/// The same for a scene's text (`path` names it in messages and gives the run its name), e.g. the
+/// scene a checkpoint keeps.
+Scene readSceneText(const std::string& text, const std::string& path);
 
 }  // namespace cfdmpm

@@ -159,6 +159,16 @@ void defineOutput(ParameterList& output)
          ParameterRule{});
   define(output, "progress_interval", 1.0, "Wall-clock time between progress lines; 0: one line per step.",
          atLeast(0, "s"));
+  define(output, "checkpoint_interval", 0.0,
+         "Simulated time between checkpoints (the complete state, for `cfdmpm --restart`; doc/output.md); "
+         "0: none by simulated time.",
+         atLeast(0, "s"));
+  define(output, "checkpoint_wall_interval", 0.0,
+         "Wall-clock time between checkpoints; 0: none by wall-clock time. With either interval set, a run "
+         "also writes a checkpoint when it stops.",
+         atLeast(0, "s"));
+  define(output, "checkpoints_kept", 2, "How many of the newest checkpoints are kept; older ones are removed.",
+         atLeast(1));
 }
 
 void defineMpm(ParameterList& mpm)

@@ -1,9 +1,11 @@
 #include "io/hdf5_writer.hpp"
 
 #include "io/collective.hpp"
+#include "io/hdf5_common.hpp"
 
 #include <hdf5.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
@@ -17,58 +19,12 @@ static_assert(std::is_same_v<hid_t, std::int64_t>, "Hdf5Writer keeps HDF5 ids as
 namespace {
 
 using io_detail::anyRank;
+using io_detail::checked;
+using io_detail::H5Handle;
 using io_detail::onRankZero;
 using io_detail::rankOf;
 
-/// An HDF5 identifier closed by its own close function when it goes out of scope.
-class H5Handle {
- public:
-  H5Handle() = default;
-  H5Handle(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
-  H5Handle(H5Handle&& other) noexcept { *this = std::move(other); }
-  H5Handle& operator=(H5Handle&& other) noexcept
-  {
-    if (this != &other) {
-      reset();
-      id_ = std::exchange(other.id_, H5I_INVALID_HID);
-      close_ = other.close_;
-    }
-    return *this;
-  }
-  H5Handle(const H5Handle&) = delete;
-  H5Handle& operator=(const H5Handle&) = delete;
-  ~H5Handle() { reset(); }
-
-  hid_t get() const { return id_; }
-  /// Closes now and reports whether the close succeeded.
-  bool close()
-  {
-    herr_t status = 0;
-    if (id_ >= 0) status = close_(id_);
-    id_ = H5I_INVALID_HID;
-    return status >= 0;
-  }
-  void reset() { close(); }
-  /// Gives up ownership without closing.
-  hid_t release() { return std::exchange(id_, H5I_INVALID_HID); }
-
- private:
-  hid_t id_ = H5I_INVALID_HID;
-  herr_t (*close_)(hid_t) = nullptr;
-};
-
-hid_t checked(hid_t id, const std::string& what)
-{
-  if (id < 0) throw std::runtime_error("HDF5: " + what + " failed");
-  return id;
-}
-
-void checked(herr_t status, const std::string& what)
-{
-  if (status < 0) throw std::runtime_error("HDF5: " + what + " failed");
-}
-
-void writeAttribute(hid_t object, const char* name, hid_t memory_type, hid_t file_type,
+void writeRawAttribute(hid_t object, const char* name, hid_t memory_type, hid_t file_type,
                     const void* data, hsize_t length)
 {
   H5Handle space(checked(length == 1 ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &length, nullptr),
@@ -84,9 +40,9 @@ void writeAttribute(hid_t object, const char* name, hid_t memory_type, hid_t fil
 void writeLayoutAttributes(hid_t group, const OutputLayout& layout)
 {
   const hsize_t n = static_cast<hsize_t>(layout.dimension);
-  writeAttribute(group, "count_xyz", H5T_NATIVE_LLONG, H5T_STD_I64LE, layout.global_count.data(), n);
-  writeAttribute(group, "origin_xyz", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, layout.origin.data(), n);
-  writeAttribute(group, "spacing_xyz", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, layout.spacing.data(), n);
+  writeRawAttribute(group, "count_xyz", H5T_NATIVE_LLONG, H5T_STD_I64LE, layout.global_count.data(), n);
+  writeRawAttribute(group, "origin_xyz", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, layout.origin.data(), n);
+  writeRawAttribute(group, "spacing_xyz", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, layout.spacing.data(), n);
 }
 
 bool isNameCharacter(char c)
@@ -141,6 +97,34 @@ std::string layoutProblem(const OutputLayout& layout, const char* location)
 
 }  // namespace
 
+H5Handle io_detail::ownedSelection(const OutputLayout& grid, int components)
+{
+  const std::vector<long long> dims = datasetDims(grid, components);
+  std::vector<hsize_t> file_dims(dims.begin(), dims.end());
+  H5Handle space(checked(H5Screate_simple(static_cast<int>(file_dims.size()), file_dims.data(), nullptr),
+                         "file dataspace"),
+                 H5Sclose);
+  checked(H5Sselect_none(space.get()), "H5Sselect_none");
+  bool first = true;
+  for (const Box& box : grid.owned_boxes) {
+    if (box.count() == 0) continue;
+    std::vector<hsize_t> start, extent;
+    for (int d = grid.dimension - 1; d >= 0; --d) {
+      start.push_back(static_cast<hsize_t>(box.lower[d]));
+      extent.push_back(static_cast<hsize_t>(box.extent(d)));
+    }
+    if (components > 1) {
+      start.push_back(0);
+      extent.push_back(static_cast<hsize_t>(components));
+    }
+    checked(H5Sselect_hyperslab(space.get(), first ? H5S_SELECT_SET : H5S_SELECT_OR, start.data(),
+                                nullptr, extent.data(), nullptr),
+            "selecting an owned box");
+    first = false;
+  }
+  return space;
+}
+
 std::string stepFileName(const std::string& run_name, long long step)
 {
   char number[32];
@@ -153,6 +137,7 @@ struct Hdf5Writer::OpenStep {
   H5Handle transfer;  // dataset transfer properties: collective MPI-IO
   H5Handle link_creation;  // creates the groups on a field's path
   H5Handle dataset_creation;
+  H5Handle group_creation;
   std::string temporary_path;
   std::string final_path;
   WrittenStep record;
@@ -234,12 +219,17 @@ void Hdf5Writer::beginStep(long long step, double time)
       H5Handle(checked(H5Pcreate(H5P_DATASET_CREATE), "dataset properties"), H5Pclose);
   // Every entry is written, so HDF5 need not write fill values first.
   checked(H5Pset_fill_time(open->dataset_creation.get(), H5D_FILL_TIME_NEVER), "H5Pset_fill_time");
+  // No modification times in the object headers: the same data gives the same bytes, so the step
+  // files of a restarted run compare equal (cmp) with those of a run that never stopped.
+  checked(H5Pset_obj_track_times(open->dataset_creation.get(), false), "H5Pset_obj_track_times");
+  open->group_creation = H5Handle(checked(H5Pcreate(H5P_GROUP_CREATE), "group properties"), H5Pclose);
+  checked(H5Pset_obj_track_times(open->group_creation.get(), false), "H5Pset_obj_track_times");
 
-  writeAttribute(open->file.get(), "time", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, &time, 1);
-  writeAttribute(open->file.get(), "step", H5T_NATIVE_LLONG, H5T_STD_I64LE, &step, 1);
+  writeRawAttribute(open->file.get(), "time", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, &time, 1);
+  writeRawAttribute(open->file.get(), "step", H5T_NATIVE_LLONG, H5T_STD_I64LE, &step, 1);
   for (OutputLocation location : {OutputLocation::Cells, OutputLocation::Nodes}) {
     H5Handle group(checked(H5Gcreate2(open->file.get(), locationName(location), H5P_DEFAULT,
-                                      H5P_DEFAULT, H5P_DEFAULT),
+                                      open->group_creation.get(), H5P_DEFAULT),
                            std::string("creating group /") + locationName(location)),
                    H5Gclose);
     writeLayoutAttributes(group.get(), layout(location));
@@ -259,8 +249,57 @@ void Hdf5Writer::writeVector(OutputLocation location, const std::string& name,
   writeField(location, name, layout(location).dimension, values, count);
 }
 
+void Hdf5Writer::writeTable(OutputLocation location, const std::string& name, const double* values,
+                            std::size_t count, int columns)
+{
+  if (columns < 1) throw std::invalid_argument("output table '" + name + "': columns must be at least 1");
+  writeField(location, name, columns, values, count, false);
+}
+
+void Hdf5Writer::writeAttribute(const std::string& name, double value)
+{
+  if (!open_) throw std::logic_error("Hdf5Writer: attribute '" + name + "' outside beginStep/endStep");
+  writeRawAttribute(open_->file.get(), name.c_str(), H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, &value, 1);
+}
+
+void Hdf5Writer::writeAttribute(const std::string& name, long long value)
+{
+  if (!open_) throw std::logic_error("Hdf5Writer: attribute '" + name + "' outside beginStep/endStep");
+  writeRawAttribute(open_->file.get(), name.c_str(), H5T_NATIVE_LLONG, H5T_STD_I64LE, &value, 1);
+}
+
+void Hdf5Writer::writeAttribute(const std::string& name, const std::vector<long long>& values)
+{
+  if (!open_) throw std::logic_error("Hdf5Writer: attribute '" + name + "' outside beginStep/endStep");
+  if (values.empty()) throw std::invalid_argument("Hdf5Writer: attribute '" + name + "' has no values");
+  const hsize_t length = values.size();
+  H5Handle space(checked(H5Screate_simple(1, &length, nullptr), "dataspace of attribute " + name), H5Sclose);
+  H5Handle attribute(checked(H5Acreate2(open_->file.get(), name.c_str(), H5T_STD_I64LE, space.get(), H5P_DEFAULT,
+                                        H5P_DEFAULT),
+                             "creating attribute " + name),
+                     H5Aclose);
+  checked(H5Awrite(attribute.get(), H5T_NATIVE_LLONG, values.data()), "writing attribute " + name);
+}
+
+void Hdf5Writer::writeAttribute(const std::string& name, const std::string& text)
+{
+  if (!open_) throw std::logic_error("Hdf5Writer: attribute '" + name + "' outside beginStep/endStep");
+  // A variable-length string would be stored in the global heap; a fixed-length one of the text's
+  // size (at least 1) reads back with h5py as bytes and needs no collective heap writes.
+  H5Handle type(checked(H5Tcopy(H5T_C_S1), "string type"), H5Tclose);
+  checked(H5Tset_size(type.get(), std::max<std::size_t>(1, text.size())), "H5Tset_size");
+  checked(H5Tset_strpad(type.get(), H5T_STR_NULLPAD), "H5Tset_strpad");
+  H5Handle space(checked(H5Screate(H5S_SCALAR), "dataspace of attribute " + name), H5Sclose);
+  H5Handle attribute(checked(H5Acreate2(open_->file.get(), name.c_str(), type.get(), space.get(), H5P_DEFAULT,
+                                        H5P_DEFAULT),
+                             "creating attribute " + name),
+                     H5Aclose);
+  const std::string stored = text.empty() ? std::string(1, '\0') : text;
+  checked(H5Awrite(attribute.get(), type.get(), stored.data()), "writing attribute " + name);
+}
+
 void Hdf5Writer::writeField(OutputLocation location, const std::string& name, int components,
-                            const double* values, std::size_t count)
+                            const double* values, std::size_t count, bool display_copy)
 {
   if (!open_) throw std::logic_error("Hdf5Writer: write '" + name + "' outside beginStep/endStep");
   if (location == OutputLocation::Particles)
@@ -280,7 +319,7 @@ void Hdf5Writer::writeField(OutputLocation location, const std::string& name, in
   writeDataset(grid, dataset_path, components, values, count);
   WrittenField field{location, name, dataset_path, components, datasetDims(grid, components),
                      dataset_path, datasetDims(grid, components)};
-  if (components == 2) {
+  if (components == 2 && display_copy) {
     std::vector<double> padded(count / 2 * 3, 0.0);
     for (std::size_t entry = 0; entry < count / 2; ++entry) {
       padded[3 * entry] = values[2 * entry];
@@ -337,11 +376,11 @@ void Hdf5Writer::writeParticleField(const std::string& name, int components, con
     MPI_Exscan(&local, &offset, 1, MPI_LONG_LONG, MPI_SUM, comm_);
     if (rankOf(comm_) == 0) offset = 0;  // MPI_Exscan leaves rank 0's result undefined
     MPI_Allreduce(&local, &total, 1, MPI_LONG_LONG, MPI_SUM, comm_);
-    H5Handle group(checked(H5Gcreate2(open_->file.get(), "particles", H5P_DEFAULT, H5P_DEFAULT,
+    H5Handle group(checked(H5Gcreate2(open_->file.get(), "particles", H5P_DEFAULT, open_->group_creation.get(),
                                       H5P_DEFAULT),
                            "creating group /particles"),
                    H5Gclose);
-    writeAttribute(group.get(), "count", H5T_NATIVE_LLONG, H5T_STD_I64LE, &total, 1);
+    writeRawAttribute(group.get(), "count", H5T_NATIVE_LLONG, H5T_STD_I64LE, &total, 1);
     open_->have_particles = true;
     open_->particle_local = local_count;
     open_->particle_offset = offset;
@@ -416,32 +455,9 @@ hid_t Hdf5Writer::fileSelection(const OutputLayout& grid, int components)
   for (const auto& [cached_key, space] : selections_)
     if (cached_key == key) return space;
 
-  // The union of the owned boxes. HDF5 transfers such a selection in the file's row-major order,
-  // which is ascending global index with x fastest: the buffer's order. Built once per location and
-  // component count, because OR-ing thousands of patch boxes costs more than the transfer.
-  const std::vector<long long> dims = datasetDims(grid, components);
-  std::vector<hsize_t> file_dims(dims.begin(), dims.end());
-  H5Handle space(checked(H5Screate_simple(static_cast<int>(file_dims.size()), file_dims.data(), nullptr),
-                         "file dataspace"),
-                 H5Sclose);
-  checked(H5Sselect_none(space.get()), "H5Sselect_none");
-  bool first = true;
-  for (const Box& box : grid.owned_boxes) {
-    if (box.count() == 0) continue;
-    std::vector<hsize_t> start, extent;
-    for (int d = grid.dimension - 1; d >= 0; --d) {
-      start.push_back(static_cast<hsize_t>(box.lower[d]));
-      extent.push_back(static_cast<hsize_t>(box.extent(d)));
-    }
-    if (components > 1) {
-      start.push_back(0);
-      extent.push_back(static_cast<hsize_t>(components));
-    }
-    checked(H5Sselect_hyperslab(space.get(), first ? H5S_SELECT_SET : H5S_SELECT_OR, start.data(),
-                                nullptr, extent.data(), nullptr),
-            "selecting an owned box");
-    first = false;
-  }
+  // Built once per location and component count: OR-ing thousands of patch boxes costs more than
+  // the transfer.
+  H5Handle space = io_detail::ownedSelection(grid, components);
   selections_.emplace_back(key, space.get());
   return space.release();  // closed by the destructor
 }
@@ -475,6 +491,7 @@ WrittenStep Hdf5Writer::endStep()
   open->transfer.reset();
   open->link_creation.reset();
   open->dataset_creation.reset();
+  open->group_creation.reset();
   const bool closed = open->file.close();
   if (anyRank(comm_, !closed)) throw std::runtime_error("HDF5: closing " + open->temporary_path + " failed");
 
@@ -497,6 +514,7 @@ void Hdf5Writer::abandonStep() noexcept
   open->transfer.reset();
   open->link_creation.reset();
   open->dataset_creation.reset();
+  open->group_creation.reset();
   open->file.reset();
   if (rankOf(comm_) == 0) {
     std::error_code ignored;

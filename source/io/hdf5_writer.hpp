@@ -94,6 +94,18 @@ class Hdf5Writer {
   void writeParticleVector(const std::string& name, const double* values, std::size_t local_count,
                            int components);
 
+  /// A cell or node table of `columns` values per entry (any count, e.g. one per material),
+  /// interleaved like a vector field, without the /padded copy: for files that are read back (the
+  /// checkpoint), not displayed. `count` is the number of doubles.
+  void writeTable(OutputLocation location, const std::string& name, const double* values,
+                  std::size_t count, int columns);
+
+  /// Attributes of the file's root group; the same value on every rank.
+  void writeAttribute(const std::string& name, double value);
+  void writeAttribute(const std::string& name, long long value);
+  void writeAttribute(const std::string& name, const std::vector<long long>& values);
+  void writeAttribute(const std::string& name, const std::string& text);
+
   /// Closes the file, renames it to its final name (rank 0) and returns what was written.
   WrittenStep endStep();
 
@@ -105,7 +117,7 @@ class Hdf5Writer {
  private:
   struct OpenStep;
   void writeField(OutputLocation location, const std::string& name, int components,
-                  const double* values, std::size_t count);
+                  const double* values, std::size_t count, bool display_copy = true);
   void writeDataset(const OutputLayout& grid, const std::string& path, int components,
                     const double* values, std::size_t count);
   std::int64_t fileSelection(const OutputLayout& grid, int components);  // an HDF5 dataspace id

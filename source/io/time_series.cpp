@@ -48,8 +48,7 @@ CsvValue::CsvValue(const char* text) : text_(csvField(text)) {}
 
 CsvValue::CsvValue(const std::string& text) : text_(csvField(text)) {}
 
-CsvTimeSeries::CsvTimeSeries(MPI_Comm comm, std::string path, std::vector<std::string> columns)
-    : comm_(comm), path_(std::move(path)), columns_(std::move(columns))
+void CsvTimeSeries::checkColumns() const
 {
   std::set<std::string> seen;
   for (const std::string& column : columns_)
@@ -57,6 +56,12 @@ CsvTimeSeries::CsvTimeSeries(MPI_Comm comm, std::string path, std::vector<std::s
       throw std::invalid_argument("time series " + path_ + ": column '" + column +
                                   "' is empty or repeated");
   if (columns_.empty()) throw std::invalid_argument("time series " + path_ + ": no columns");
+}
+
+CsvTimeSeries::CsvTimeSeries(MPI_Comm comm, std::string path, std::vector<std::string> columns)
+    : comm_(comm), path_(std::move(path)), columns_(std::move(columns))
+{
+  checkColumns();
 
   io_detail::onRankZero(comm_, [&] {
     file_ = std::fopen(path_.c_str(), "w");
@@ -70,6 +75,46 @@ CsvTimeSeries::CsvTimeSeries(MPI_Comm comm, std::string path, std::vector<std::s
       file_ = nullptr;
       throw;
     }
+  });
+}
+
+CsvTimeSeries::CsvTimeSeries(MPI_Comm comm, std::string path, std::vector<std::string> columns, long long last_step)
+    : comm_(comm), path_(std::move(path)), columns_(std::move(columns))
+{
+  checkColumns();
+  io_detail::onRankZero(comm_, [&] {
+    std::FILE* old = std::fopen(path_.c_str(), "rb");
+    if (!old) throw InputError("restart: cannot open the time series " + path_ + ": " + std::strerror(errno));
+    std::string text;
+    char buffer[1 << 16];
+    std::size_t n = 0;
+    while ((n = std::fread(buffer, 1, sizeof buffer, old)) > 0) text.append(buffer, n);
+    std::fclose(old);
+
+    std::vector<std::string> header;
+    for (const std::string& column : columns_) header.push_back(csvField(column));
+    const std::string header_line = joined(header);
+    if (text.compare(0, header_line.size(), header_line) != 0)
+      throw InputError("restart: the time series " + path_ +
+                       " does not have the columns this scene writes (a different scene or version?)");
+    // Rows are whole lines (each written and flushed at once); the step is the first field.
+    std::size_t end = header_line.size();
+    for (long long step = 0; step <= last_step; ++step) {
+      const std::size_t line_end = text.find('\n', end);
+      const std::string first = line_end == std::string::npos ? "" : text.substr(end, text.find(',', end) - end);
+      if (line_end == std::string::npos || first != std::to_string(step))
+        throw InputError("restart: the time series " + path_ + " lacks the row of step " + std::to_string(step) +
+                         " (the checkpoint is at step " + std::to_string(last_step) + ")");
+      end = line_end + 1;
+    }
+    const std::string temporary = path_ + ".tmp";
+    std::FILE* kept = std::fopen(temporary.c_str(), "wb");
+    if (!kept) throw std::runtime_error("cannot create " + temporary + ": " + std::strerror(errno));
+    const bool written = std::fwrite(text.data(), 1, end, kept) == end;
+    if (std::fclose(kept) != 0 || !written || std::rename(temporary.c_str(), path_.c_str()) != 0)
+      throw std::runtime_error("rewriting " + path_ + " failed: " + std::strerror(errno));
+    file_ = std::fopen(path_.c_str(), "a");
+    if (!file_) throw std::runtime_error("cannot append to " + path_ + ": " + std::strerror(errno));
   });
 }
 

@@ -36,6 +36,11 @@ class CsvTimeSeries {
   /// Creates (truncates) `path` and writes the header row. Collective; every rank throws if the
   /// file cannot be written. Column names must be unique and non-empty.
   CsvTimeSeries(MPI_Comm comm, std::string path, std::vector<std::string> columns);
+  /// Continues the series in `path` after a restart: the header must be `columns`; the rows of
+  /// steps 0 to `last_step` (the first column) are kept and must all be there, in order; later rows
+  /// are dropped (the file is rewritten through a temporary file and a rename). Collective; every
+  /// rank throws InputError naming the file if it is missing or does not match.
+  CsvTimeSeries(MPI_Comm comm, std::string path, std::vector<std::string> columns, long long last_step);
   ~CsvTimeSeries();
   CsvTimeSeries(const CsvTimeSeries&) = delete;
   CsvTimeSeries& operator=(const CsvTimeSeries&) = delete;
@@ -51,6 +56,8 @@ class CsvTimeSeries {
   MPI_Comm comm_;
   std::string path_;
   std::vector<std::string> columns_;
+  void checkColumns() const;
+
   std::FILE* file_ = nullptr;  // rank 0 only
 };
 

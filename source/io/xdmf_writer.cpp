@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 namespace cfdmpm {
@@ -203,14 +204,105 @@ void XdmfWriter::addStep(const WrittenStep& step)
 
   io_detail::onRankZero(comm_, [&] {
     writeFileAtomically(stepPath(step), documentHead() + xdmfStep(cells_, step, 4) + documentTail());
-
-    std::string series = documentHead();
-    series += "    <Grid Name=\"" + escaped(run_name_) +
-              "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-    for (const WrittenStep& written : steps_) series += xdmfStep(cells_, written, 6);
-    series += "    </Grid>\n" + documentTail();
-    writeFileAtomically(seriesPath(), series);
+    writeSeries();
   });
+}
+
+void XdmfWriter::restoreSteps(std::vector<WrittenStep> steps)
+{
+  steps_ = std::move(steps);
+  io_detail::onRankZero(comm_, [&] { writeSeries(); });
+}
+
+void XdmfWriter::writeSeries() const
+{
+  std::string series = documentHead();
+  series += "    <Grid Name=\"" + escaped(run_name_) +
+            "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  for (const WrittenStep& written : steps_) series += xdmfStep(cells_, written, 6);
+  series += "    </Grid>\n" + documentTail();
+  writeFileAtomically(seriesPath(), series);
+}
+
+namespace {
+
+std::string dimsText(const std::vector<long long>& dims)
+{
+  std::string text;
+  for (std::size_t i = 0; i < dims.size(); ++i) text += (i ? " " : "") + std::to_string(dims[i]);
+  return text;
+}
+
+std::vector<long long> dimsFromText(const std::string& text)
+{
+  std::istringstream in(text);
+  std::vector<long long> dims;
+  long long n = 0;
+  while (in >> n) dims.push_back(n);
+  return dims;
+}
+
+std::vector<std::string> tabFields(const std::string& line)
+{
+  std::vector<std::string> fields;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t tab = line.find('\t', start);
+    fields.push_back(line.substr(start, tab == std::string::npos ? std::string::npos : tab - start));
+    if (tab == std::string::npos) return fields;
+    start = tab + 1;
+  }
+}
+
+}  // namespace
+
+// step <TAB> number <TAB> time (%.17g, exact) <TAB> file
+// field <TAB> location <TAB> components <TAB> name <TAB> dataset <TAB> dims <TAB> display dataset <TAB> display dims
+std::string stepRecordsText(const std::vector<WrittenStep>& steps)
+{
+  std::string text;
+  char time[32];
+  for (const WrittenStep& step : steps) {
+    std::snprintf(time, sizeof time, "%.17g", step.time);
+    text += "step\t" + std::to_string(step.step) + "\t" + time + "\t" + step.file + "\n";
+    for (const WrittenField& f : step.fields)
+      text += "field\t" + std::to_string(int(f.location)) + "\t" + std::to_string(f.components) + "\t" + f.name +
+              "\t" + f.dataset + "\t" + dimsText(f.dims) + "\t" + f.display_dataset + "\t" +
+              dimsText(f.display_dims) + "\n";
+  }
+  return text;
+}
+
+std::vector<WrittenStep> stepRecordsFromText(const std::string& text)
+{
+  std::vector<WrittenStep> steps;
+  std::istringstream in(text);
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    const std::vector<std::string> f = tabFields(line);
+    try {
+      if (f[0] == "step" && f.size() == 4) {
+        WrittenStep step;
+        step.step = std::stoll(f[1]);
+        step.time = std::stod(f[2]);
+        step.file = f[3];
+        steps.push_back(step);
+        continue;
+      }
+      if (f[0] == "field" && f.size() == 8 && !steps.empty()) {
+        const int location = std::stoi(f[1]);
+        if (location < 0 || location > int(OutputLocation::Particles)) throw std::invalid_argument("location");
+        steps.back().fields.push_back(WrittenField{OutputLocation(location), f[3], f[4], std::stoi(f[2]),
+                                                   dimsFromText(f[5]), f[6], dimsFromText(f[7])});
+        continue;
+      }
+    } catch (const std::exception&) {
+    }
+    throw std::invalid_argument("output step records: line " + std::to_string(number) + " is not a record");
+  }
+  return steps;
 }
 
 }  // namespace cfdmpm

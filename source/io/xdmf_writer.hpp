@@ -56,11 +56,17 @@ class XdmfWriter {
   /// every rank throws if writing fails.
   void addStep(const WrittenStep& step);
 
+  /// After a restart: sets the steps written before the checkpoint and rewrites the time series to
+  /// list exactly those. Collective, like addStep.
+  void restoreSteps(std::vector<WrittenStep> steps);
+
   std::string seriesPath() const;                       // <directory>/<run>.xmf
   std::string stepPath(const WrittenStep& step) const;  // <directory>/<run>_<step>.xmf
   const std::vector<WrittenStep>& steps() const { return steps_; }
 
  private:
+  void writeSeries() const;  // rank 0
+
   MPI_Comm comm_;
   std::string directory_;
   std::string run_name_;
@@ -70,5 +76,11 @@ class XdmfWriter {
 
 /// Writes `text` to `path` through `path`.tmp and a rename, so `path` is always whole.
 void writeFileAtomically(const std::string& path, const std::string& text);
+
+/// The records of written steps as text, one tab-separated line per step and per field, and back
+/// (std::invalid_argument on text that is not such a record). A checkpoint keeps them, so that a
+/// restarted run's time series lists the steps written before it exactly as the first run did.
+std::string stepRecordsText(const std::vector<WrittenStep>& steps);
+std::vector<WrittenStep> stepRecordsFromText(const std::string& text);
 
 }  // namespace cfdmpm

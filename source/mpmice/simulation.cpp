@@ -1,6 +1,8 @@
 #include "mpmice/simulation.hpp"
 
 #include "common/mpi_comm.hpp"
+#include "input/parameter_rule.hpp"
+#include "mpmice/checkpoint.hpp"
 #include "mpmice/mpmice_step.hpp"
 #include "io/output_directory.hpp"
 #include "io/progress.hpp"
@@ -9,6 +11,7 @@
 #include "mpmice/initial_state.hpp"
 #include "mpmice/state_output.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -144,11 +147,21 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
     return row;
   };
 
-  // 3. Output: the directory (refused if it holds an earlier run, unless overwrite), the fields of
-  //    step 0, and the diagnostics time series.
+  // 3. Output. A new run: the directory (refused if it holds an earlier run, unless overwrite), the
+  //    fields of step 0 and the diagnostics time series. A restart: the state, the solvers' own
+  //    state and the run's clock from the checkpoint; what the first run wrote after it is removed,
+  //    the time series and the CSV continue from it.
   StateOutput<Dim>::checkFields(scene);
-  prepareOutputDirectory(mpi, scene.output.directory, options.overwrite || scene.output.overwrite);
-  const std::string run_name = std::filesystem::path(scene.path).stem().string();
+  const bool restarting = !options.restart_checkpoint.empty();
+  const std::string run_name =
+      options.run_name.empty() ? std::filesystem::path(scene.path).stem().string() : options.run_name;
+  RunClock clock;
+  std::vector<WrittenStep> written_before;
+  if (restarting) {
+    clock = readCheckpoint(options.restart_checkpoint, layout, state, stepper, written_before);
+  } else {
+    prepareOutputDirectory(mpi, scene.output.directory, options.overwrite || scene.output.overwrite);
+  }
   StateOutput<Dim> output(scene, *layout, run_name);
   std::vector<std::string> columns{"step", "time", "dt", "dt_limiter"};
   if (moves)
@@ -156,7 +169,9 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
   else
     for (const std::string& c : conservedColumns<Dim>(scene)) columns.push_back(c);
   const std::string csv_path = scene.output.directory + "/" + run_name + ".csv";
-  CsvTimeSeries diagnostics(mpi, csv_path, columns);
+  const auto diagnostics = restarting ? std::make_unique<CsvTimeSeries>(mpi, csv_path, columns, clock.step)
+                                      : std::make_unique<CsvTimeSeries>(mpi, csv_path, columns);
+  if (restarting) prepareRestartDirectory(mpi, scene.output.directory, run_name, clock.step);
   auto report = [&](long long step, double time, double dt, const std::string& limiter) {
     std::vector<CsvValue> row{step, time, dt, limiter};
     if (moves) {
@@ -164,7 +179,7 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
     } else {
       for (double q : conservedQuantities(state)) row.emplace_back(q);
     }
-    diagnostics.append(row);
+    diagnostics->append(row);
   };
 
   installStopSignalHandlers();
@@ -176,28 +191,65 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
     const mpm::ParticleOutput out = stepper.particles()->output();
     return output.write(step, time, state, &out);
   };
-  const std::string first = writeOutput(0, 0.0);
-  report(0, 0.0, 0.0, "initial");
-  if (root) std::cout << "  wrote initial state: " << first << "\n";
   summary.time_series = output.seriesPath();
+  if (restarting) {
+    output.restoreSteps(written_before);
+    if (root)
+      std::cout << "  restarted from " << options.restart_checkpoint << ": step " << clock.step << ", t = "
+                << showNumber(clock.time) << " s\n";
+  } else {
+    const std::string first = writeOutput(0, 0.0);
+    report(0, 0.0, 0.0, "initial");
+    if (root) std::cout << "  wrote initial state: " << first << "\n";
+  }
   if (!moves) {
     if (root) std::cout << "  ice.enabled is false and the scene has no solids: nothing moves; stopping\n";
     return summary;
   }
 
-  // 4. The time loop: Δt from the solver's limits, clipped to land on output times and the end.
+  // 4. Checkpoints, every output.checkpoint_interval of simulated time or checkpoint_wall_interval
+  //    of wall time (rank 0's clock decides for all), and when the run stops.
+  const double checkpoint_interval = scene.output.checkpoint_interval;
+  const double checkpoint_wall = scene.output.checkpoint_wall_interval;
+  std::unique_ptr<CheckpointWriter<Dim>> checkpoints;
+  if (checkpoint_interval > 0 || checkpoint_wall > 0)
+    checkpoints = std::make_unique<CheckpointWriter<Dim>>(scene, *layout, run_name, scene.output.directory);
+  auto last_checkpoint_wall = std::chrono::steady_clock::now();
+  long long last_checkpoint_step = restarting ? clock.step : -1;
+  auto writeCheckpoint = [&] {
+    const std::string path = checkpoints->write(clock, state, stepper, output.writtenSteps());
+    last_checkpoint_step = clock.step;
+    last_checkpoint_wall = std::chrono::steady_clock::now();
+    if (root) std::cout << "  checkpoint: " << path << "\n";
+  };
+  auto wallCheckpointDue = [&] {
+    int due = 0;
+    if (root)
+      due = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint_wall).count() >=
+            checkpoint_wall;
+    MPI_Bcast(&due, 1, MPI_INT, 0, mpi);
+    return due != 0;
+  };
+
+  // 5. The time loop: Δt from the solver's limits, clipped to land on output times and the end.
+  //    output_mark is the next output time before clipping to the end, so that a restart with a
+  //    later end time continues the same schedule.
   const double end = scene.time.end_time;
   const double interval = scene.output.interval;
-  double next_output = interval > 0 ? interval : end;
-  double t = 0, dt_previous = 0;
-  long long step = 0;
-  int unconverged_warnings = 0;
-  ProgressReporter progress(mpi, 0.0, end, scene.output.progress_interval);
+  const double output_period = interval > 0 ? interval : end;
+  if (!restarting) {
+    clock.output_mark = output_period;
+    clock.checkpoint_mark = checkpoint_interval;
+  }
+  double next_output = restarting ? std::min(end, clock.output_mark) : clock.output_mark;
+  double& t = clock.time;
+  long long& step = clock.step;
+  ProgressReporter progress(mpi, t, end, scene.output.progress_interval);
   const double eps = 1e-12 * end;
   while (t < end - eps && (scene.time.max_steps < 0 || step < scene.time.max_steps)) {
-    TimeStepLimit limit = stepper.stableTimeStep(state, dt_previous);
+    TimeStepLimit limit = stepper.stableTimeStep(state, clock.dt_previous);
     if (step == 0 && scene.time.dt_initial < limit.dt) limit = {scene.time.dt_initial, "dt_initial"};
-    dt_previous = limit.dt;
+    clock.dt_previous = limit.dt;
     double dt = limit.dt;
     if (t + dt > next_output - eps) {
       dt = next_output - t;
@@ -209,21 +261,30 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
       limit.limiter += "+output";
     }
     step_report = stepper.step(state, dt);
-    if (stepper.fluidsMove() && !step_report.ice.converged && root && ++unconverged_warnings <= 10)
+    // Counted on every rank (the report is the same on all): a checkpoint stores the count.
+    if (stepper.fluidsMove() && !step_report.ice.converged && ++clock.unconverged_warnings <= 10 && root)
       std::cout << "  warning: step " << step + 1 << ": the pressure's outer iteration stopped at residual "
                 << step_report.ice.outer_residual << " after " << step_report.ice.outer_iterations
                 << " iterations (ice.outer_tolerance " << stepper.fluids()->settings().outer_tolerance
                 << ", ice.max_outer_iterations " << stepper.fluids()->settings().max_outer_iterations
                 << "); column pressure_converged of the CSV marks such steps"
-                << (unconverged_warnings == 10 ? " (further warnings suppressed)" : "") << "\n";
+                << (clock.unconverged_warnings == 10 ? " (further warnings suppressed)" : "") << "\n";
     t = (t + dt > next_output - eps) ? next_output : t + dt;
+    const bool output_time = t >= next_output - eps;
     ++step;
     report(step, t, dt, limit.limiter);
     const bool stop = stopRequested(mpi);
     const bool last = t >= end - eps || stop || (scene.time.max_steps >= 0 && step >= scene.time.max_steps);
-    if (t >= next_output - eps || last) {
-      writeOutput(step, t);
-      next_output = std::min(end, next_output + (interval > 0 ? interval : end));
+    if (output_time || last) writeOutput(step, t);
+    if (output_time) {
+      clock.output_mark += output_period;
+      next_output = std::min(end, clock.output_mark);
+    }
+    if (checkpoints) {
+      bool due = checkpoint_interval > 0 && t >= clock.checkpoint_mark - eps;
+      while (checkpoint_interval > 0 && t >= clock.checkpoint_mark - eps) clock.checkpoint_mark += checkpoint_interval;
+      if (checkpoint_wall > 0 && wallCheckpointDue()) due = true;
+      if (due || (last && last_checkpoint_step != step)) writeCheckpoint();
     }
     progress.update(step, t, dt, last);
     if (stop) {

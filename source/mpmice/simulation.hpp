@@ -12,6 +12,10 @@ namespace cfdmpm {
 
 struct RunOptions {
   bool overwrite = false;  // replace the output of an earlier run (also output.overwrite)
+  // A restart: the checkpoint to continue from, and the run's name (its files' prefix) as the
+  // first run chose it. The scene's output.directory is the one holding the checkpoint.
+  std::string restart_checkpoint;
+  std::string run_name;
 };
 
 struct RunSummary {

@@ -6,24 +6,6 @@
 
 namespace cfdmpm {
 
-namespace {
-
-template <int Dim>
-OutputLayout outputLayout(const Grid<Dim>& grid, Location location, const std::vector<Box>& boxes)
-{
-  OutputLayout out;
-  out.dimension = Dim;
-  out.global_count = location == Location::Cell ? grid.cells() : grid.nodes();
-  for (int d = 0; d < 3; ++d) {
-    out.origin[d] = d < Dim ? grid.lower()[d] : 0.0;
-    out.spacing[d] = d < Dim ? grid.spacing()[d] : 1.0;
-  }
-  out.owned_boxes = boxes;
-  return out;
-}
-
-}  // namespace
-
 template <int Dim>
 void StateOutput<Dim>::checkFields(const Scene& scene)
 {

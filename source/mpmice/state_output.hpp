@@ -13,6 +13,21 @@
 
 namespace cfdmpm {
 
+/// The io module's description of the grid at `location` with this rank's owned boxes.
+template <int Dim>
+OutputLayout outputLayout(const Grid<Dim>& grid, Location location, const std::vector<Box>& boxes)
+{
+  OutputLayout out;
+  out.dimension = Dim;
+  out.global_count = location == Location::Cell ? grid.cells() : grid.nodes();
+  for (int d = 0; d < 3; ++d) {
+    out.origin[d] = d < Dim ? grid.lower()[d] : 0.0;
+    out.spacing[d] = d < Dim ? grid.spacing()[d] : 1.0;
+  }
+  out.owned_boxes = boxes;
+  return out;
+}
+
 template <int Dim>
 class StateOutput {
  public:
@@ -29,6 +44,11 @@ class StateOutput {
                     const mpm::ParticleOutput* particles = nullptr);
 
   std::string seriesPath() const { return xdmf_->seriesPath(); }
+
+  /// The steps written so far (for a checkpoint), and after a restart the steps written before it
+  /// (the time series is rewritten to list exactly those).
+  const std::vector<WrittenStep>& writtenSteps() const { return xdmf_->steps(); }
+  void restoreSteps(std::vector<WrittenStep> steps) { xdmf_->restoreSteps(std::move(steps)); }
 
  private:
   void writeColumns(const Field<Dim>& field, int first_column, int components, const std::string& name);

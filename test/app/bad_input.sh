@@ -100,6 +100,12 @@ expect unknown_material "$(REGION_MATERIAL=mud good)" "mud" "water" "air"
 expect unknown_kind "$(AIR_KIND=gas good)" "kind" "gas" "fluid"
 expect region_outside "$(REGION_X=1.7 good)" "column" "1.7"
 expect unknown_key "$(good | sed 's/  time: {/  time: {end_tme: 1, /')" "end_tme"
+expect negative_checkpoint_interval "$(good | sed 's/interval: 0.01}/interval: 0.01, checkpoint_interval: -0.5}/')" \
+  "cfdmpm.output.checkpoint_interval" "-0.5" ">= 0 (s)"
+expect negative_checkpoint_wall_interval "$(good | sed 's/interval: 0.01}/interval: 0.01, checkpoint_wall_interval: -60}/')" \
+  "cfdmpm.output.checkpoint_wall_interval" "-60" ">= 0 (s)"
+expect no_checkpoints_kept "$(good | sed 's/interval: 0.01}/interval: 0.01, checkpoints_kept: 0}/')" \
+  "cfdmpm.output.checkpoints_kept" "'0'" ">= 1"
 expect missing_key "$(good | grep -v '  time:')" "time"
 expect two_top_level_keys "$(good; echo 'extra: {a: 1}')" "extra"
 # Refused at set-up: by --check as by the run, with the same message.

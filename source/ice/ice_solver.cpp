@@ -312,7 +312,7 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
               return;
             }
             const double pressure_difference = p(c, 0) - p(l, 0);
-            ice::MaterialArray<double> tl{}, tr{}, vl{}, vr{}, vel{}, sv{};
+            ice::MaterialArray<double> tl{}, tr{}, vl{}, vr{}, vel{}, sv{}, own{};
             for (int m = 0; m < nm; ++m) {
               tl[m] = theta(l, m), tr[m] = theta(c, m), vl[m] = v(l, m), vr[m] = v(c, m);
               const double rl = rho(l, m), rr = rho(c, m);
@@ -324,7 +324,7 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
               vel[m] = roles.rigid[m]        ? mean
                        : roles.lagrangian[m] ? mean - dt_per_h * vbar * pressure_difference
                                              : mean - dt_per_h * vbar * pressure_difference + dt * g;
-              if (with_solids && roles.lagrangian[m]) kinematic(c, m) = mean;
+              own[m] = mean;  // a solid's face velocity from its particles' own motion
             }
             // On the face a material has the shares fl (just below it) and fr (just above): a
             // fluid its cells' volume fractions, a solid its share of the face (solidFaceShares). At
@@ -363,7 +363,7 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
                 continue;
               }
               const bool present = tl[m] + tr[m] > 2 * kNegligibleVolumeShare;
-              if (with_solids && roles.lagrangian[m]) kinematic(c, m) = open * (present ? kinematic(c, m) : mixture);
+              if (with_solids && roles.lagrangian[m]) kinematic(c, m) = open * (present ? own[m] : mixture);
               uf(c, m) = open * (present ? vel[m] : mixture);
               vf(c, m) = open * (present ? sv[m] : b);  // and follows the mixture's pressure correction
             }

@@ -264,7 +264,7 @@ AdvectionStatus Advector<Dim>::outfluxStatus(const LargestOutflow& local) const
 
 template <int Dim>
 AdvectionStatus Advector<Dim>::advect(FaceField<Dim>& face_velocity, double dt, Field<Dim>& mass,
-                                      const std::vector<Field<Dim>*>& mass_specific)
+                                      const std::vector<Field<Dim>*>& mass_specific, const CapView& outflow_share)
 {
   if (mass.columns() != materials_)
     throw std::invalid_argument("Advector: mass has " + std::to_string(mass.columns()) + " columns, expected " +
@@ -285,7 +285,8 @@ AdvectionStatus Advector<Dim>::advect(FaceField<Dim>& face_velocity, double dt, 
 
   // 2. Mass leaving each cell through each face, from the limited density profile of the donor,
   //    and the slab values of every mass-specific column, in one pass that also checks the outflow.
-  const AdvectionStatus status = outfluxStatus(reconstruct(face_velocity, dt, mass, mass_specific));
+  const AdvectionStatus status =
+      outfluxStatus(reconstruct(face_velocity, dt, mass, mass_specific, false, outflow_share));
   if (!status.ok) return status;
 
   // 3. New mass and compatible update of every column, then the outputs' ghosts.
@@ -337,8 +338,10 @@ const typename Advector<Dim>::WorkView& Advector<Dim>::slabDensities(const FaceF
 
 template <int Dim>
 LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass,
-                                          const std::vector<Field<Dim>*>& mass_specific, bool slab_densities)
+                                          const std::vector<Field<Dim>*>& mass_specific, bool slab_densities,
+                                          const CapView& outflow_share)
 {
+  const bool capped = outflow_share.extent(0) > 0;
   const Slabs<Dim> slabs(face_velocity, *layout_, dt, options_.transverse_correction);
   const CellStencil<Dim> stencil(*layout_, block_);
   const auto M = mass.view();
@@ -422,7 +425,7 @@ LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, d
           double slab_mass[2 * Dim];
           double left = value;  // the mass that stays in the cell
           for (int f = 0; f < 2 * Dim; ++f) {
-            slab_mass[f] = fraction[f] * (value + phi * slope[f]);
+            slab_mass[f] = fraction[f] * (value + phi * slope[f]) * (capped ? outflow_share(c, f) : 1.0);
             outflow_mass(c, f, m) = slab_mass[f];
             if (slab_densities) slab_density(c, f, m) = value + phi * slope[f];
             left -= slab_mass[f];

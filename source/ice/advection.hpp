@@ -73,8 +73,13 @@ class Advector {
   ///   Updated in place so that (M q)_new = M q + Σ fluxes of M q.
   /// Input ghosts are refreshed before the step and output ghosts after it. If the status is not
   /// ok, nothing is changed.
+  /// - outflow_share (optional, (local cell, face f = 2 d + side), owned and ghost cells): the share
+  ///   of each slab's profile that leaves, in [0, 1] (1 where not given): with solids in the cells,
+  ///   the room the solids leave the fluids on a face over what the profiles hold
+  ///   (IceSolver::fluidFaceFractions).
+  using CapView = Kokkos::View<double**, MemorySpace>;
   AdvectionStatus advect(FaceField<Dim>& face_velocity, double dt, Field<Dim>& mass,
-                         const std::vector<Field<Dim>*>& mass_specific);
+                         const std::vector<Field<Dim>*>& mass_specific, const CapView& outflow_share = CapView());
 
   /// The limited mass profile of every cell (owned and ghost) evaluated in the outflow slab of each
   /// of its faces for these face velocities, i.e. the bulk density that advect() would move through
@@ -94,7 +99,8 @@ class Advector {
  private:
   /// The slab pass; returns this rank's largest outflow fraction and where it occurs.
   LargestOutflow reconstruct(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass,
-                             const std::vector<Field<Dim>*>& mass_specific, bool slab_densities = false);
+                             const std::vector<Field<Dim>*>& mass_specific, bool slab_densities = false,
+                             const CapView& outflow_share = CapView());
   AdvectionStatus outfluxStatus(const LargestOutflow& local) const;
   void update(Field<Dim>& mass, const std::vector<Field<Dim>*>& mass_specific);
 

@@ -138,6 +138,10 @@ IceSolver<Dim>::IceSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>>
       solid_reference_pressure_(layout, Location::Cell, 1, "solid_reference_pressure")
 {
   solid_reference_pressure_.fill(scene.initial.pressure);
+  if (!solids.empty()) {
+    fluid_outflow_share_ = typename Advector<Dim>::CapView("fluid outflow share", layout->overlapCells(), 2 * Dim);
+    Kokkos::deep_copy(fluid_outflow_share_, 1.0);
+  }
   if (materials_ > ice::kMaxMaterials)
     throw InputError("cfdmpm.materials: " + std::to_string(materials_) + " materials; at most " +
                      std::to_string(ice::kMaxMaterials) + " are allowed");
@@ -392,17 +396,40 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
   const auto theta = state.volume_fraction.view();
   const auto neighbours = layout_->cellNeighbours();
   const int n = materials_;
+  const auto roles = roles_;
+  auto leaves = fluid_outflow_share_;
   for (int d = 0; d < Dim; ++d) {
     auto out = fluid_face_fraction_.direction(d).view();
+    const auto share = solid_face_share_.direction(d).view();
     Kokkos::parallel_for(
         "ice::fluidFaceFractions", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->overlapCells()),
         KOKKOS_LAMBDA(const LocalOrdinal c) {
           const LocalOrdinal l = neighbours(c, 2 * d);
+          double fluid[2] = {0, 0}, solid[2] = {0, 0};
           for (int m = 0; m < n; ++m) {
+            if (roles.lagrangian[m] || roles.rigid[m]) {
+              for (int side = 0; side < 2; ++side) solid[side] += Kokkos::Experimental::fmin(1.0, share(c, 2 * m + side));
+              out(c, 2 * m) = out(c, 2 * m + 1) = 0.0;
+              continue;
+            }
             // Donor below the face (its upper face 2 d + 1) and donor above (this cell's lower face).
             out(c, 2 * m) = l >= 0 ? slab(l, 2 * d + 1, m) * v(l, m) : theta(c, m);
             out(c, 2 * m + 1) = slab(c, 2 * d, m) * v(c, m);
+            fluid[0] += out(c, 2 * m), fluid[1] += out(c, 2 * m + 1);
           }
+          // The fluids cross a face in at most the room the solids leave there: a cell's linear
+          // profile cannot hold the sharp edge of a solid inside the cell, and above a sand
+          // surface it would carry water down through a face that the sand covers (and trap it in
+          // the sand's cells, where a share of 1e-3 is ~30 kPa of the sand's bulk modulus).
+          double keep[2];
+          for (int side = 0; side < 2; ++side) {
+            const double room = solid[side] < 1.0 ? 1.0 - solid[side] : 0.0;
+            keep[side] = fluid[side] > room ? room / fluid[side] : 1.0;
+          }
+          for (int m = 0; m < n; ++m)
+            for (int side = 0; side < 2; ++side) out(c, 2 * m + side) *= keep[side];
+          if (l >= 0) leaves(l, 2 * d + 1) = keep[0];
+          leaves(c, 2 * d) = keep[1];
         });
   }
 }
@@ -897,7 +924,7 @@ void IceSolver<Dim>::advectionPhase(CellState<Dim>& state, double dt, IceStepRep
   }
   std::vector<Field<Dim>*> carried{&state.velocity, &state.specific_volume};
   if (!settings_.isothermal) carried.push_back(&state.temperature);  // c_v T is the energy per mass
-  const AdvectionStatus advected = advector_->advect(face_velocity_, dt, state.density, carried);
+  const AdvectionStatus advected = advector_->advect(face_velocity_, dt, state.density, carried, fluid_outflow_share_);
   report.max_outflux_fraction = advected.max_outflux_fraction;
   if (!advected.ok) throw std::runtime_error("ice: " + advected.message());
 

@@ -931,6 +931,7 @@ TimeSpec readTime(ParameterList& list)
   time.dt_min = list.get<double>("dt_min");
   time.dt_max = list.get<double>("dt_max");
   time.max_steps = list.get<long long>("max_steps");
+  time.step_retries = list.get<int>("step_retries");
   if (time.dt_min > time.dt_max) {
     throw inputError(path + ".dt_min", showNumber(time.dt_min), "must be <= dt_max (" + showNumber(time.dt_max) + " s)");
   }

@@ -2,6 +2,7 @@
 #include "input/parameter_rule.hpp"
 #include "input/scene.hpp"
 #include "input/scene_checks.hpp"
+#include "common/error.hpp"
 #include "common/mpi_comm.hpp"
 #include "mpmice/checkpoint.hpp"
 #include "mpmice/simulation.hpp"
@@ -41,7 +42,9 @@ const char* kUsage =
     "  --help        print this help\n"
     "  --version     print the version\n"
     "\n"
-    "exit codes: 0 the run reached its end (or --check passed), 1 run-time failure, 2 bad input or\n"
+    "exit codes: 0 the run reached its end (or --check passed), 1 run-time failure (such as a step\n"
+    "            that still failed after time.step_retries retries with half the time step: the last\n"
+    "            good state is written as a step file and a checkpoint), 2 bad input or\n"
     "            bad command line (a missing or unreadable checkpoint too),\n"
     "            3 stopped by SIGINT or SIGTERM before its end (the files written are complete, and\n"
     "            with checkpoints on a last checkpoint is written; a second signal ends the program\n"
@@ -184,6 +187,10 @@ int main(int argc, char** argv)
   } catch (const cfdmpm::InputError& e) {
     if (root) writeError(std::string("cfdmpm: error: ") + e.what());
     return 2;
+  } catch (const cfdmpm::StepFailure& e) {
+    // Thrown on every rank with the same message.
+    if (root) writeError(std::string("cfdmpm: error: ") + e.what());
+    return 1;
   } catch (const std::exception& e) {
     writeError("cfdmpm: rank " + std::to_string(comm->getRank()) + ": failure: " + e.what());
     return 1;

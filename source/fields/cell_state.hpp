@@ -4,6 +4,7 @@
 // sets switched on or off). Columns are materials; the velocity has Dim columns per material.
 #include "fields/field.hpp"
 
+#include <array>
 #include <memory>
 
 namespace cfdmpm {
@@ -19,6 +20,25 @@ struct CellState {
         temperature(layout, Location::Cell, material_count, "temperature"),
         pressure(layout, Location::Cell, 1, "pressure")
   {
+  }
+
+  /// The fields, with their names, in a fixed order.
+  std::array<Field<Dim>*, 6> fields()
+  {
+    return {&volume_fraction, &density, &specific_volume, &velocity, &temperature, &pressure};
+  }
+  std::array<const Field<Dim>*, 6> fields() const
+  {
+    return {&volume_fraction, &density, &specific_volume, &velocity, &temperature, &pressure};
+  }
+
+  /// Takes the values of every field, owned and ghost entries, from `other` (same layout and
+  /// materials): undoing a step restores the state from a copy.
+  void assign(const CellState& other)
+  {
+    const auto from = other.fields();
+    const auto to = fields();
+    for (std::size_t f = 0; f < to.size(); ++f) Kokkos::deep_copy(to[f]->view(), from[f]->view());
   }
 
   /// Column of velocity component d of material m.

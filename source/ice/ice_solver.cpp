@@ -1,5 +1,7 @@
 #include "ice/ice_solver.hpp"
 
+#include "common/error.hpp"
+
 #include "ice/equilibration.hpp"
 #include "ice/exchange.hpp"
 #include "ice/material_eos.hpp"
@@ -942,13 +944,14 @@ void IceSolver<Dim>::pressurePhase(CellState<Dim>& state, double dt, IceStepRepo
       report.linear_iterations += solve.iterations;
       if (!solve.converged) {
         std::ostringstream message;
-        message << std::scientific << std::setprecision(3) << "ice: pressure solve did not converge: relative residual "
+        message << std::scientific << std::setprecision(3)
+                << "ice: the pressure correction's linear solve did not converge: relative residual "
                 << solve.relative_residual << " after " << solve.iterations << " CG iterations, tolerance "
                 << solve.tolerance;
         if (!solve.failure.empty()) message << " (" << solve.failure << ")";
         if (settings_.solver_tolerance_given && settings_.solver_tolerance < 1e-13)
           message << "; cfdmpm.ice.solver_tolerance below ~1e-13 can stall at round-off";
-        throw std::runtime_error(message.str());
+        throw StepFailure(message.str());
       }
     } else {
       // Explicit: δp = rhs / (V κ) (faces not coupled through the pressure Laplacian) and
@@ -1019,7 +1022,15 @@ void IceSolver<Dim>::advectionPhase(CellState<Dim>& state, double dt, IceStepRep
   if (!settings_.isothermal) carried.push_back(&state.temperature);  // c_v T is the energy per mass
   const AdvectionStatus advected = advector_->advect(face_velocity_, dt, state.density, carried, fluid_outflow_share_);
   report.max_outflux_fraction = advected.max_outflux_fraction;
-  if (!advected.ok) throw std::runtime_error("ice: " + advected.message());
+  if (!advected.ok) {
+    // The same on every rank: the status is reduced over all of them.
+    const auto ijk = layout_->grid().cellIndex(advected.cell);
+    std::ostringstream message;
+    message << "ice: advection: the outflux of " << names_[advected.material] << " from cell (" << ijk[0] << ", "
+            << ijk[1] << (Dim == 3 ? ", " + std::to_string(ijk[2]) : std::string()) << ") is "
+            << advected.max_outflux_fraction << " of its volume in one step (at most 1)";
+    throw StepFailure(message.str());
+  }
 
   // Closure: θ = ρ v (the next equilibration restores Σθ = 1); a material without mass in a cell
   // takes the mixture's velocity and temperature there (advection leaves its own values undefined).

@@ -3,6 +3,7 @@
 #include "ice/pressure_solver.hpp"
 
 #include "common/error.hpp"
+#include "common/mpi_comm.hpp"
 #include "input/parameter_rule.hpp"
 
 #include <BelosLinearProblem.hpp>
@@ -516,14 +517,16 @@ void PressureSolver<Dim>::assemble(const Field<Dim>& mixture_compressibility, Fa
       },
       Kokkos::Min<LocalOrdinal>(first_bad));
 
-  // A bad coefficient on any rank stops every rank (so none waits in a collective).
-  int local_bad = first_bad < owned ? 1 : 0, any_bad = 0;
-  Teuchos::reduceAll(*lay.comm(), Teuchos::REDUCE_MAX, local_bad, Teuchos::outArg(any_bad));
-  if (any_bad) {
+  // A bad coefficient on any rank stops every rank (so none waits in a collective), with the
+  // message of the lowest rank that found one.
+  const int ranks = lay.comm()->getSize();
+  int reporter = first_bad < owned ? lay.comm()->getRank() : ranks, first_reporter = ranks;
+  Teuchos::reduceAll(*lay.comm(), Teuchos::REDUCE_MIN, reporter, Teuchos::outArg(first_reporter));
+  if (first_reporter < ranks) {
     m.assembled = false;  // the values are partly overwritten: no solve with this matrix
     std::ostringstream message;
-    message << "PressureSolver::assemble: ";
-    if (local_bad) {
+    message << "pressure equation: ";
+    if (reporter == first_reporter) {
       const auto ijk = lay.grid().cellIndex(lay.ownedCellMap()->getGlobalElement(first_bad));
       message << "cell (" << ijk[0] << ", " << ijk[1] << ", " << ijk[2] << ") has compressibility "
               << kappa(first_bad, 0) << " 1/Pa (must be > 0) or a face coefficient that is negative or not finite"
@@ -534,10 +537,8 @@ void PressureSolver<Dim>::assemble(const Field<Dim>& mixture_compressibility, Fa
         else message << " " << beta.direction[f / 2](f % 2 == 0 ? first_bad : n, 0);
       }
       message << " m^3/kg)";
-    } else {
-      message << "a bad coefficient on another rank";
     }
-    throw std::runtime_error(message.str());
+    throw StepFailure(broadcastText(rawMpiComm(lay.comm()), first_reporter, message.str()));
   }
 
   m.assembled = true;

@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <map>
 #include <sstream>
 
 namespace cfdmpm {
@@ -234,6 +235,200 @@ void refuseOtherTopLevelKeys(const std::string& text, const std::string& path)
   if (!root_line) throw InputError(path + ": no top-level key; " + rule);
 }
 
+// --- The keys as written ------------------------------------------------------------------------
+//
+// Teuchos's YAML reader keeps the numbers it reads, not their text, and stops at a repeated key with
+// 'Parameter "x" already exists in list "ANONYMOUS"' at the line after it. This pass reads the
+// structure of the file (block maps by indentation, flow maps and lists on one line, as the reader
+// takes them) to refuse a repeated key with its own line and column, and to keep each value's text,
+// so that messages echo 40.0 as 40.0 and 1e-400 as 1e-400, not as 40 and 0.
+
+struct WrittenValue {
+  std::string text;
+  int line = 0;
+};
+using WrittenValues = std::map<std::string, WrittenValue>;  // by key path: cfdmpm.time.cfl
+
+class SceneIndexer {
+ public:
+  SceneIndexer(const std::string& path, WrittenValues& values) : path_(path), values_(values) {}
+
+  void read(const std::string& text)
+  {
+    std::istringstream lines(text);
+    std::string line;
+    int number = 0;
+    levels_.push_back({0, "", {}, false});  // the file: its keys start in column 0
+    while (std::getline(lines, line)) {
+      ++number;
+      if (!line.empty() && line.back() == '\r') line.pop_back();
+      const std::size_t indent = line.find_first_not_of(' ');
+      if (indent == std::string::npos || line[indent] == '#' || line[indent] == '%') continue;
+      if (indent == 0 && (line.rfind("---", 0) == 0 || line.rfind("...", 0) == 0)) continue;
+      if (line[indent] == '\t') return;  // tabs: leave the structure to the YAML reader
+      const int column = int(indent);
+      if (levels_.back().pending) {
+        if (column > levels_[levels_.size() - 2].indent) {
+          levels_.back().indent = column, levels_.back().pending = false;
+        } else {
+          levels_.pop_back();
+        }
+      }
+      while (levels_.size() > 1 && levels_.back().indent > column) levels_.pop_back();
+      if (levels_.back().indent != column || line[indent] == '-') continue;  // continuation, list item
+      std::size_t at = indent;
+      std::string key;
+      if (!readKey(line, at, key)) continue;
+      Level& level = levels_.back();
+      const std::string key_path = childPath(level.path, key);
+      refuseRepeated(level, key, number, indent);
+      const std::string rest = valueText(line, at);
+      if (rest.empty()) {
+        levels_.push_back({-1, key_path, {}, true});
+      } else {
+        std::size_t position = line.find_first_not_of(" \t", at);
+        readValue(line, position, key_path, number);
+      }
+    }
+  }
+
+ private:
+  struct Level {
+    int indent;
+    std::string path;
+    std::map<std::string, int> keys;  // key -> line
+    bool pending;                     // opened by a key without a value; its indent comes next
+  };
+
+  static std::string childPath(const std::string& parent, const std::string& key)
+  {
+    return parent.empty() ? key : parent + "." + key;
+  }
+
+  // The text after a block key's colon, without a comment and surrounding blanks.
+  static std::string valueText(const std::string& line, std::size_t at)
+  {
+    std::string rest = line.substr(at);
+    for (std::size_t i = 0; i < rest.size(); ++i)
+      if (rest[i] == '#' && (i == 0 || rest[i - 1] == ' ' || rest[i - 1] == '\t')) {
+        rest.erase(i);
+        break;
+      }
+    const std::size_t first = rest.find_first_not_of(" \t");
+    if (first == std::string::npos) return "";
+    return rest.substr(first, rest.find_last_not_of(" \t") + 1 - first);
+  }
+
+  // A key ending in ': ' (or ':' at the end, or before a flow value in a flow map); `at` moves past
+  // the colon. Quoted keys lose their quotes.
+  bool readKey(const std::string& line, std::size_t& at, std::string& key) const
+  {
+    if (at < line.size() && (line[at] == '"' || line[at] == '\'')) {
+      const std::size_t close = line.find(line[at], at + 1);
+      if (close == std::string::npos || close + 1 >= line.size() || line[close + 1] != ':') return false;
+      key = line.substr(at + 1, close - at - 1);
+      at = close + 2;
+      return true;
+    }
+    for (std::size_t i = at; i < line.size(); ++i) {
+      const char c = line[i];
+      if (c == '#' && i > at && (line[i - 1] == ' ' || line[i - 1] == '\t')) return false;
+      if (c == ',' || c == '}' || c == '{' || c == '[' || c == ']') return false;
+      if (c == ':' && (i + 1 == line.size() || line[i + 1] == ' ' || line[i + 1] == '\t')) {
+        key = line.substr(at, i - at);
+        key.erase(key.find_last_not_of(" \t") + 1);
+        at = i + 1;
+        return !key.empty();
+      }
+    }
+    return false;
+  }
+
+  void refuseRepeated(Level& level, const std::string& key, int line, std::size_t index)
+  {
+    const auto [first, inserted] = level.keys.emplace(key, line);
+    if (inserted) return;
+    throw InputError(path_ + ":" + std::to_string(line) + ":" + std::to_string(index + 1) + ": key '" + key + "' of " +
+                     (level.path.empty() ? std::string("the file") : level.path) + " given twice (first on line " +
+                     std::to_string(first->second) + "); give each key once");
+  }
+
+  // A value starting at line[at]: a flow map, a flow list (its text kept whole), a quoted string
+  // (skipped) or a plain scalar (its text kept); `at` moves past it.
+  void readValue(const std::string& line, std::size_t& at, const std::string& key_path, int number)
+  {
+    if (at >= line.size()) return;
+    const char c = line[at];
+    if (c == '{') {
+      readFlowMap(line, at, key_path, number);
+    } else if (c == '[') {
+      const std::size_t start = at;
+      int depth = 0;
+      for (; at < line.size(); ++at) {
+        if (line[at] == '[') ++depth;
+        if (line[at] == ']' && --depth == 0) break;
+      }
+      if (at < line.size()) values_[key_path] = {line.substr(start, at - start + 1), number};
+      ++at;
+    } else if (c == '"' || c == '\'') {
+      const std::size_t close = line.find(c, at + 1);
+      at = close == std::string::npos ? line.size() : close + 1;
+    } else {
+      const std::size_t start = at;
+      while (at < line.size() && line[at] != ',' && line[at] != '}' && line[at] != ']' &&
+             !(line[at] == '#' && (line[at - 1] == ' ' || line[at - 1] == '\t')))
+        ++at;
+      std::string text = line.substr(start, at - start);
+      text.erase(text.find_last_not_of(" \t") + 1);
+      if (!text.empty()) values_[key_path] = {text, number};
+    }
+  }
+
+  void readFlowMap(const std::string& line, std::size_t& at, const std::string& path, int number)
+  {
+    Level level{-1, path, {}, false};
+    ++at;  // '{'
+    while (at < line.size()) {
+      at = line.find_first_not_of(" \t,", at);
+      if (at == std::string::npos || line[at] == '}') {
+        if (at != std::string::npos) ++at;
+        return;
+      }
+      const std::size_t key_start = at;
+      std::string key;
+      if (!readKey(line, at, key)) return;  // not a form this pass knows: the reader decides
+      refuseRepeated(level, key, number, key_start);
+      at = line.find_first_not_of(" \t", at);
+      if (at == std::string::npos) return;
+      readValue(line, at, childPath(path, key), number);
+    }
+  }
+
+  const std::string& path_;
+  WrittenValues& values_;
+  std::vector<Level> levels_;
+};
+
+// The values of the scene being read, as written (readSceneText sets it for the time it reads).
+const WrittenValues* g_written_values = nullptr;
+
+// A value for a message, quoted: as the file wrote it when known, else as read. A number beyond the
+// range of a double says what it became ('1e-400' (read as 0: ...)).
+std::string shownValue(const std::string& key_path, const ParameterEntry& entry)
+{
+  const auto found = g_written_values ? g_written_values->find(key_path) : WrittenValues::const_iterator();
+  if (!g_written_values || found == g_written_values->end()) return "'" + showValue(entry) + "'";
+  const std::string& text = found->second.text;
+  if (entry.isType<double>()) {
+    errno = 0;
+    char* end = nullptr;
+    const double value = std::strtod(text.c_str(), &end);
+    if (errno == ERANGE && end && *end == '\0' && (value == 0 || std::isinf(value)))
+      return "'" + text + "' (read as " + showValue(entry) + ": beyond the range of a double)";
+  }
+  return "'" + text + "'";
+}
+
 // Teuchos messages carry source locations and "Throw number" lines; keep what a user can act on.
 std::string cleanTeuchosMessage(const std::string& message)
 {
@@ -305,7 +500,7 @@ std::string expectation(const ParameterEntry& valid_entry, int dimension)
 InputError wrongType(const std::string& key_path, const ParameterEntry& entry, const ParameterEntry& valid_entry,
                      int dimension)
 {
-  return InputError(key_path + ": got '" + showValue(entry) + "' (" + givenType(entry) + "); expected " +
+  return InputError(key_path + ": got " + shownValue(key_path, entry) + " (" + givenType(entry) + "); expected " +
                     expectation(valid_entry, dimension));
 }
 
@@ -351,7 +546,7 @@ void checkEntry(ParameterEntry& entry, const ParameterEntry& valid_entry, const 
   }
   if (const ParameterRule* rule = ruleOf(valid_entry)) {
     const std::string problem = rule->problem(entry, dimension);
-    if (!problem.empty()) throw inputError(key_path, showValue(entry), problem);
+    if (!problem.empty()) throw InputError(key_path + ": got " + shownValue(key_path, entry) + "; " + problem);
   }
 }
 
@@ -736,6 +931,7 @@ TimeSpec readTime(ParameterList& list)
   time.dt_min = list.get<double>("dt_min");
   time.dt_max = list.get<double>("dt_max");
   time.max_steps = list.get<long long>("max_steps");
+  time.step_retries = list.get<int>("step_retries");
   if (time.dt_min > time.dt_max) {
     throw inputError(path + ".dt_min", showNumber(time.dt_min), "must be <= dt_max (" + showNumber(time.dt_max) + " s)");
   }
@@ -805,7 +1001,13 @@ Scene readSceneText(const std::string& file_text, const std::string& path)
   // 1. The file: one top-level key `cfdmpm`, valid YAML.
   const std::string text = screenText(file_text, path);
   refuseOtherTopLevelKeys(text, path);
+  WrittenValues written;
+  SceneIndexer(path, written).read(text);
   RCP<ParameterList> root = parseYaml(text, path);
+  struct WrittenValuesScope {
+    explicit WrittenValuesScope(const WrittenValues& values) { g_written_values = &values; }
+    ~WrittenValuesScope() { g_written_values = nullptr; }
+  } written_scope(written);
 
   Scene scene;
   scene.path = path;

@@ -56,6 +56,7 @@ struct TimeSpec {
   double dt_min = 1e-10;     // s
   double dt_max = 1e-2;      // s
   long long max_steps = -1;  // -1: no limit
+  int step_retries = 3;      // a failed step is undone and retried with half its Δt this many times
 };
 
 struct OutputSpec {

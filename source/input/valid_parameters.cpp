@@ -142,6 +142,11 @@ void defineTime(ParameterList& time)
          atLeast(0, "s"));
   define(time, "dt_max", 1.0e-2, "Largest time step.", positive("s"));
   define(time, "max_steps", -1LL, "Stop after this many steps; -1: no limit.", atLeast(-1));
+  define(time, "step_retries", 3,
+         "How often a failed step (values not finite, a pressure solve or outer iteration that does not converge, "
+         "an outflux larger than a cell, an inverted particle) is undone and retried with half its time step "
+         "before the run stops (doc/input.md, \"A failed step\").",
+         between(0, false, 50, false));
 }
 
 void defineOutput(ParameterList& output)

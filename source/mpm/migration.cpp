@@ -1,5 +1,6 @@
 #include "mpm/migration.hpp"
 
+#include "common/error.hpp"
 #include "common/mpi_comm.hpp"
 
 #include <sstream>
@@ -177,8 +178,7 @@ MigrationCounts ParticleMigration<Dim>::operator()(Particles<Dim>& particles, co
   int failed_rank = -1;
   for (int q = 0; q < ranks_ && failed_rank < 0; ++q)
     if (recv_header[2 * q + 1]) failed_rank = q;
-  if (failed_rank >= 0)
-    throw std::runtime_error(error.empty() ? "MPM: stopped by an error on rank " + std::to_string(failed_rank) : error);
+  if (failed_rank >= 0) throw StepFailure(broadcastText(comm_, failed_rank, error));
 
   std::vector<int> recv_counts(ranks_, 0), recv_offsets(ranks_ + 1, 0);
   for (int q = 0; q < ranks_; ++q) recv_counts[q] = recv_header[2 * q];

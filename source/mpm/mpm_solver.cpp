@@ -6,6 +6,7 @@
 #include <Teuchos_CommHelpers.hpp>
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -884,6 +885,109 @@ MigrationCounts MpmSolver<Dim>::relocateParticles()
   pending_error_.clear();
   bins_current_ = false;
   return (*migration_)(particles_, error);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Undoing a step
+// ---------------------------------------------------------------------------------------------
+
+template <int Dim>
+void MpmSolver<Dim>::saveParticles(ParticleSnapshot& snapshot) const
+{
+  const Particles<Dim> particles = particles_;
+  const int n = particles.count;
+  if (int(snapshot.extent(0)) < n)
+    snapshot = ParticleSnapshot("particle snapshot", std::size_t(n + n / 2), Particles<Dim>::kPackedSize);
+  const ParticleSnapshot rows = snapshot;
+  Kokkos::parallel_for(
+      "mpm::saveParticles", Kokkos::RangePolicy<ExecutionSpace>(0, n),
+      KOKKOS_LAMBDA(const int p) { particles.pack(p, &rows(p, 0)); });
+}
+
+template <int Dim>
+void MpmSolver<Dim>::restoreParticles(const ParticleSnapshot& snapshot, int count)
+{
+  particles_.resize(count);
+  const Particles<Dim> particles = particles_;
+  Kokkos::parallel_for(
+      "mpm::restoreParticles", Kokkos::RangePolicy<ExecutionSpace>(0, count),
+      KOKKOS_LAMBDA(const int p) { particles.unpack(&snapshot(p, 0), p); });
+  Kokkos::fence();
+  pending_error_.clear();
+  bins_current_ = false;
+}
+
+namespace {
+
+constexpr const char* kParticleQuantities[] = {"position", "velocity", "volume", "deformation gradient",
+                                               "stress", "out-of-plane stress", "plastic strain"};
+
+/// The first quantity of particle p (index in kParticleQuantities) that is not finite, or -1.
+template <int Dim>
+KOKKOS_INLINE_FUNCTION int nonFiniteQuantity(const Particles<Dim>& particles, int p)
+{
+  using Kokkos::Experimental::isfinite;
+  for (int d = 0; d < Dim; ++d)
+    if (!isfinite(particles.position(p, d))) return 0;
+  for (int d = 0; d < Dim; ++d)
+    if (!isfinite(particles.velocity(p, d))) return 1;
+  if (!isfinite(particles.volume(p))) return 2;
+  for (int d = 0; d < Dim; ++d)
+    for (int e = 0; e < Dim; ++e)
+      if (!isfinite(particles.deformation_gradient(p, d, e))) return 3;
+  for (int d = 0; d < Dim; ++d)
+    for (int e = 0; e < Dim; ++e)
+      if (!isfinite(particles.stress(p, d, e))) return 4;
+  const MaterialState state = particles.state(p);
+  if (!isfinite(state.out_of_plane_stress)) return 5;
+  if (!isfinite(state.equivalent_plastic_strain) || !isfinite(state.volumetric_plastic_strain)) return 6;
+  return -1;
+}
+
+}  // namespace
+
+template <int Dim>
+std::string MpmSolver<Dim>::nonFiniteParticle() const
+{
+  const Particles<Dim> particles = particles_;
+  const int n = particles.count;
+  long long lowest = LLONG_MAX, global_lowest = LLONG_MAX;
+  Kokkos::parallel_reduce(
+      "mpm::nonFiniteParticle", Kokkos::RangePolicy<ExecutionSpace>(0, n),
+      KOKKOS_LAMBDA(const int p, long long& found) {
+        if (nonFiniteQuantity(particles, p) >= 0 && particles.id(p) < found) found = particles.id(p);
+      },
+      Kokkos::Min<long long>(lowest));
+  const auto& comm = *layout_->comm();
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_MIN, lowest, Teuchos::outArg(global_lowest));
+  if (global_lowest == LLONG_MAX) return "";
+  const int ranks = comm.getSize();
+  const int reporter = lowest == global_lowest ? comm.getRank() : ranks;
+  int first_reporter = ranks;
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_MIN, reporter, Teuchos::outArg(first_reporter));
+  std::string message;
+  if (reporter == first_reporter) {
+    // The particle's packed row on the host, and the quantity found.
+    Kokkos::View<double*, MemorySpace> row("non-finite particle", Particles<Dim>::kPackedSize);
+    Kokkos::View<int, MemorySpace> quantity("non-finite quantity");
+    Kokkos::parallel_for(
+        "mpm::describeParticle", Kokkos::RangePolicy<ExecutionSpace>(0, n), KOKKOS_LAMBDA(const int p) {
+          if (particles.id(p) != global_lowest) return;
+          particles.pack(p, row.data());
+          quantity() = nonFiniteQuantity(particles, p);
+        });
+    const auto host = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), row);
+    int q = 0;
+    Kokkos::deep_copy(q, quantity);
+    const int material = int(host(Particles<Dim>::kPackedSize - 2));
+    std::ostringstream text;
+    text.precision(10);
+    text << "MPM: particle " << global_lowest << " of material " << materials_[material].name << " at (";
+    for (int d = 0; d < Dim; ++d) text << (d ? ", " : "") << host(d);
+    text << ") m: its " << kParticleQuantities[q] << " is not finite";
+    message = text.str();
+  }
+  return broadcastText(rawMpiComm(layout_->comm()), first_reporter, message);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -151,6 +151,21 @@ class MpmSolver {
   /// the cell mass of particlesToCells). Rigid particles take no change.
   void addCellVelocityChange(const Field<Dim>& change);
 
+  // --- undoing a step (the driver retries a failed step with a smaller Δt) ------------------------
+  /// The rank's particles, each row a particle's whole state in the order of Particles::pack.
+  using ParticleSnapshot = Kokkos::View<double**, Kokkos::LayoutRight, MemorySpace>;
+  /// Copies the rank's particles into `snapshot` (resized as needed).
+  void saveParticles(ParticleSnapshot& snapshot) const;
+  /// Makes the rank's particles those of `snapshot`, in its order, and forgets what the undone step
+  /// left behind (its pending errors, its particle bins). Collective only in that every rank must
+  /// restore its own snapshot of the same step.
+  void restoreParticles(const ParticleSnapshot& snapshot, int count);
+  /// The particle with the lowest id, over all ranks, one of whose quantities (position, velocity,
+  /// volume, deformation gradient, stress, plastic state) is not finite, described with its id,
+  /// material, position and the quantity; empty when every particle is finite. Collective; the
+  /// same text on every rank.
+  std::string nonFiniteParticle() const;
+
   /// Moves to a new decomposition of the same grid (dynamic load balancing): new node fields, and
   /// the particles go to their new owners. Collective.
   void repartition(std::shared_ptr<const Layout<Dim>> layout);

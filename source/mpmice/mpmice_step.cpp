@@ -2,8 +2,13 @@
 
 #include "mpmice/initial_state.hpp"
 
+#include "common/error.hpp"
+
+#include <Teuchos_CommHelpers.hpp>
 #include <Teuchos_TimeMonitor.hpp>
 
+#include <algorithm>
+#include <climits>
 #include <sstream>
 #include <stdexcept>
 
@@ -98,7 +103,7 @@ CoupledStepReport MpmIceStep<Dim>::step(CellState<Dim>& state, double dt)
               << ", j = " << (cell / layout_->grid().cells()[0]) % layout_->grid().cells()[1]
               << "); a material's density, volume fraction or velocity there is not finite (reduce the time step "
                  "or check the materials' parameters)";
-      throw std::runtime_error(message.str());
+      throw StepFailure(message.str());
     }
   }
   // 9. The solids' velocity change from the pressure force and the exchange back to the nodes;
@@ -118,7 +123,88 @@ CoupledStepReport MpmIceStep<Dim>::step(CellState<Dim>& state, double dt)
     Teuchos::TimeMonitor phase(*timers_.at("10 advection"));
     ice_->advectionPhase(state, dt, report.ice);
   }
+  // 12. Every value of the new state is finite (the phases check what they can cure; this catches
+  //     the rest, such as a stress update that overflowed).
+  {
+    Teuchos::TimeMonitor phase(*timers_.at("12 finite"));
+    checkFinite(state);
+  }
   return report;
+}
+
+template <int Dim>
+void MpmIceStep<Dim>::saveState(const CellState<Dim>& state)
+{
+  if (!saved_state_) saved_state_ = std::make_unique<CellState<Dim>>(layout_, state.materials);
+  saved_state_->assign(state);
+  if (mpm_) {
+    mpm_->saveParticles(saved_particles_);
+    saved_particle_count_ = mpm_->particles().count;
+  }
+}
+
+template <int Dim>
+void MpmIceStep<Dim>::restoreState(CellState<Dim>& state)
+{
+  if (!saved_state_) throw std::logic_error("MpmIceStep::restoreState without saveState");
+  state.assign(*saved_state_);
+  if (mpm_) mpm_->restoreParticles(saved_particles_, saved_particle_count_);
+  // The undone step's pressure matrices may have refreshed a reused preconditioner: build anew.
+  if (ice_) ice_->restartPreconditionerSchedule();
+}
+
+template <int Dim>
+void MpmIceStep<Dim>::checkFinite(const CellState<Dim>& state) const
+{
+  // The lowest (global cell id, field, column) with a value that is not finite, as one key.
+  constexpr long long kKeysPerCell = 256;  // 6 fields x at most 32 columns (8 materials x 3 components)
+  const auto ijk = layout_->cellIndex();
+  const long long nx = layout_->grid().cells()[0], ny = layout_->grid().cells()[1];
+  const auto fields = state.fields();
+  long long first = LLONG_MAX;
+  for (std::size_t f = 0; f < fields.size(); ++f) {
+    const auto v = fields[f]->view();
+    const int columns = fields[f]->columns();
+    const long long field_key = 32 * static_cast<long long>(f);
+    long long found = LLONG_MAX;
+    Kokkos::parallel_reduce(
+        "mpmice::checkFinite", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+        KOKKOS_LAMBDA(const LocalOrdinal c, long long& lowest) {
+          for (int k = 0; k < columns; ++k)
+            if (!Kokkos::Experimental::isfinite(v(c, k))) {
+              const long long gid = ijk(c, 0) + nx * (ijk(c, 1) + (Dim == 3 ? ny * ijk(c, 2) : 0));
+              const long long key = gid * kKeysPerCell + field_key + k;
+              if (key < lowest) lowest = key;
+              return;
+            }
+        },
+        Kokkos::Min<long long>(found));
+    first = std::min(first, found);
+  }
+  long long global_first = LLONG_MAX;
+  Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_MIN, first, Teuchos::outArg(global_first));
+  if (global_first != LLONG_MAX) {
+    const long long gid = global_first / kKeysPerCell;
+    const int f = int(global_first % kKeysPerCell) / 32, column = int(global_first % 32);
+    const auto cell = layout_->grid().cellIndex(gid);
+    std::ostringstream message;
+    message << "coupled step: cell (" << cell[0] << ", " << cell[1] << (Dim == 3 ? ", " + std::to_string(cell[2]) : "")
+            << "): ";
+    const std::string& field = fields[f]->name();
+    if (fields[f] == &state.pressure) {
+      message << "the pressure";
+    } else if (fields[f] == &state.velocity) {
+      message << "the velocity (" << "xyz"[column % Dim] << ") of " << scene_.materials[column / Dim].name;
+    } else {
+      message << "the " << field << " of " << scene_.materials[column].name;
+    }
+    message << " is not finite";
+    throw StepFailure(message.str());
+  }
+  if (mpm_) {
+    const std::string particle = mpm_->nonFiniteParticle();
+    if (!particle.empty()) throw StepFailure(particle);
+  }
 }
 
 template <int Dim>

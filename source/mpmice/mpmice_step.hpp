@@ -14,6 +14,10 @@
 //    9. the solids' velocity change of steps 6 and 8 back to the nodes; grid to particles; stress
 //   10. advection of the fluids (solids are Lagrangian)
 //   11. the next Δt (stableTimeStep): the smaller of the fluid and the particle limits
+//   12. the state is finite: a cell or particle value that is not fails the step
+//
+// A step that fails throws StepFailure on every rank; saveState before it and restoreState after it
+// undo it (the driver then retries it with a smaller Δt).
 //
 // A scene without solids runs steps 3-6, 8 and 10; a dry scene (ice.enabled false) steps 1 and 9:
 // the same step with one material set empty.
@@ -47,6 +51,12 @@ class MpmIceStep {
   /// failed.
   CoupledStepReport step(CellState<Dim>& state, double dt);
 
+  /// Keeps a copy of everything a step changes: the cell state and the particles.
+  void saveState(const CellState<Dim>& state);
+  /// Puts back the copy of saveState, so that the next step starts as the undone one did. The
+  /// pressure solve after it builds a fresh preconditioner (nothing of the undone step is reused).
+  void restoreState(CellState<Dim>& state);
+
   /// [11] The largest stable Δt: the fluid step's limits and the particles' wave speed, the
   /// smallest named in the limiter (e.g. "convection(water)", "wave_speed(sand)").
   TimeStepLimit stableTimeStep(const CellState<Dim>& state, double previous_dt) const;
@@ -60,7 +70,7 @@ class MpmIceStep {
   /// The phases, timed by Teuchos timers named "mpmice: <phase>" ("step" is the whole step).
   static constexpr const char* kPhases[] = {"step",     "1 particles to grid", "2 particles to cells",
                                             "3-6 fluid pressure", "8 exchange", "9 grid to particles",
-                                            "10 advection"};
+                                            "10 advection", "12 finite"};
   double phaseSeconds(const std::string& phase) const { return timers_.at(phase)->totalElapsedTime(); }
 
  private:
@@ -68,6 +78,9 @@ class MpmIceStep {
   void cellsFromParticles(CellState<Dim>& state, double dt);
   /// The solids' cell velocity change since cellsFromParticles, in the particle solver's columns.
   void velocityChange(const CellState<Dim>& state);
+  /// [12] Throws StepFailure naming the first cell (lowest global id) or particle (lowest id), its
+  /// material and the quantity, if a value of the state or of a particle is not finite.
+  void checkFinite(const CellState<Dim>& state) const;
 
   Scene scene_;
   std::shared_ptr<const Layout<Dim>> layout_;
@@ -77,6 +90,9 @@ class MpmIceStep {
   std::unique_ptr<Field<Dim>> cell_change_;     // velocity change of the solids' cells (same columns)
   std::unique_ptr<Field<Dim>> solid_velocity_;  // the solids' cell velocity from the particles
   std::map<std::string, Teuchos::RCP<Teuchos::Time>> timers_;
+  std::unique_ptr<CellState<Dim>> saved_state_;        // saveState's copy
+  typename mpm::MpmSolver<Dim>::ParticleSnapshot saved_particles_;
+  int saved_particle_count_ = 0;
 };
 
 extern template class MpmIceStep<2>;

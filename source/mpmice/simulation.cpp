@@ -1,5 +1,6 @@
 #include "mpmice/simulation.hpp"
 
+#include "common/error.hpp"
 #include "common/mpi_comm.hpp"
 #include "input/parameter_rule.hpp"
 #include "mpmice/checkpoint.hpp"
@@ -13,8 +14,10 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <sstream>
 
 namespace cfdmpm {
 
@@ -84,6 +87,19 @@ std::vector<std::string> conservedColumns(const Scene& scene, bool fluids_only =
     columns.push_back("kinetic_energy_" + m.name);
   }
   return columns;
+}
+
+/// The failure of the lowest rank that has one, on every rank; empty when no rank failed.
+/// Collective: every rank ends each step attempt here, so a failure on any rank stops all of them
+/// together instead of leaving some waiting in the next collective.
+std::string agreedFailure(MPI_Comm comm, const std::string& failure)
+{
+  int rank = 0, ranks = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &ranks);
+  int reporter = failure.empty() ? ranks : rank, first = ranks;
+  MPI_Allreduce(&reporter, &first, 1, MPI_INT, MPI_MIN, comm);
+  return first == ranks ? std::string() : broadcastText(comm, first, failure);
 }
 
 template <int Dim>
@@ -163,7 +179,7 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
     prepareOutputDirectory(mpi, scene.output.directory, options.overwrite || scene.output.overwrite);
   }
   StateOutput<Dim> output(scene, *layout, run_name);
-  std::vector<std::string> columns{"step", "time", "dt", "dt_limiter"};
+  std::vector<std::string> columns{"step", "time", "dt", "dt_limiter", "retries"};
   if (moves)
     columns.insert(columns.end(), physics_columns.begin(), physics_columns.end());
   else
@@ -172,8 +188,8 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
   const auto diagnostics = restarting ? std::make_unique<CsvTimeSeries>(mpi, csv_path, columns, clock.step)
                                       : std::make_unique<CsvTimeSeries>(mpi, csv_path, columns);
   if (restarting) prepareRestartDirectory(mpi, scene.output.directory, run_name, clock.step);
-  auto report = [&](long long step, double time, double dt, const std::string& limiter) {
-    std::vector<CsvValue> row{step, time, dt, limiter};
+  auto report = [&](long long step, double time, double dt, const std::string& limiter, int retries) {
+    std::vector<CsvValue> row{step, time, dt, limiter, retries};
     if (moves) {
       for (CsvValue& v : physicsRow()) row.push_back(v);
     } else {
@@ -199,7 +215,7 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
                 << showNumber(clock.time) << " s\n";
   } else {
     const std::string first = writeOutput(0, 0.0);
-    report(0, 0.0, 0.0, "initial");
+    report(0, 0.0, 0.0, "initial", 0);
     if (root) std::cout << "  wrote initial state: " << first << "\n";
   }
   if (!moves) {
@@ -246,6 +262,57 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
   long long& step = clock.step;
   ProgressReporter progress(mpi, t, end, scene.output.progress_interval);
   const double eps = 1e-12 * end;
+
+  // A failed step (mpmice_step.hpp: StepFailure, or a pressure outer iteration that did not reach
+  // its tolerance) is undone and retried with half its Δt, up to time.step_retries times and not
+  // below time.dt_min. An outer iteration that still has not converged then is accepted with a
+  // warning (column pressure_converged); any other failure ends the run: the state from before the
+  // step is written as a step file and a checkpoint, and StepFailure names the step, the cell or
+  // particle, the material and the quantity. CFDMPM_TEST_UNDO_STEP=<n>, for tests only: step n is
+  // undone once after it succeeded and run again with the same Δt (the run must not change).
+  const char* undo_hook = std::getenv("CFDMPM_TEST_UNDO_STEP");
+  const long long test_undo_step = undo_hook ? std::atoll(undo_hook) : -1;
+  auto outerIterationFailure = [&] {
+    std::ostringstream text;
+    text << "the pressure's outer iteration stopped at residual " << step_report.ice.outer_residual << " after "
+         << step_report.ice.outer_iterations << " iterations (ice.outer_tolerance "
+         << stepper.fluids()->settings().outer_tolerance << ", ice.max_outer_iterations "
+         << stepper.fluids()->settings().max_outer_iterations << ")";
+    return text.str();
+  };
+  // One attempt at the step; the failure, the same text on every rank, or empty.
+  auto attempt = [&](double dt) {
+    std::string failure;
+    try {
+      step_report = stepper.step(state, dt);
+    } catch (const StepFailure& e) {
+      failure = e.what();
+    }
+    return agreedFailure(mpi, failure);
+  };
+  auto giveUp = [&](const std::string& failure, int retries, double dt) {
+    // The state is the one before the failed step: the last good one.
+    const std::vector<WrittenStep>& written = output.writtenSteps();
+    const std::string file = written.empty() || written.back().step != step
+                                 ? writeOutput(step, t)
+                                 : scene.output.directory + "/" + written.back().file;
+    if (!checkpoints)
+      checkpoints = std::make_unique<CheckpointWriter<Dim>>(scene, *layout, run_name, scene.output.directory);
+    if (last_checkpoint_step != step) writeCheckpoint();
+    std::ostringstream message;
+    message << "step " << step + 1 << " from t = " << showNumber(t) << " s failed";
+    if (retries > 0) message << " " << retries + 1 << " times, the last with dt = " << showNumber(dt) << " s";
+    message << ": " << failure << ". "
+            << (retries < scene.time.step_retries
+                    ? "Half that time step would be below time.dt_min (" + showNumber(scene.time.dt_min) + " s)"
+                    : "time.step_retries is " + std::to_string(scene.time.step_retries))
+            << ". The last good state, step " << step << " at t = " << showNumber(t) << " s, is in " << file
+            << " and its checkpoint in "
+            << checkpointDirectory(scene.output.directory) << "/ (cfdmpm --restart " << scene.output.directory
+            << " [scene.yaml] continues from it, e.g. with a smaller time.cfl or time.dt_max)";
+    throw StepFailure(message.str());
+  };
+
   while (t < end - eps && (scene.time.max_steps < 0 || step < scene.time.max_steps)) {
     TimeStepLimit limit = stepper.stableTimeStep(state, clock.dt_previous);
     if (step == 0 && scene.time.dt_initial < limit.dt) limit = {scene.time.dt_initial, "dt_initial"};
@@ -260,19 +327,48 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
       dt = 0.5 * (next_output - t);
       limit.limiter += "+output";
     }
-    step_report = stepper.step(state, dt);
-    // Counted on every rank (the report is the same on all): a checkpoint stores the count.
-    if (stepper.fluidsMove() && !step_report.ice.converged && ++clock.unconverged_warnings <= 10 && root)
-      std::cout << "  warning: step " << step + 1 << ": the pressure's outer iteration stopped at residual "
-                << step_report.ice.outer_residual << " after " << step_report.ice.outer_iterations
-                << " iterations (ice.outer_tolerance " << stepper.fluids()->settings().outer_tolerance
-                << ", ice.max_outer_iterations " << stepper.fluids()->settings().max_outer_iterations
-                << "); column pressure_converged of the CSV marks such steps"
-                << (clock.unconverged_warnings == 10 ? " (further warnings suppressed)" : "") << "\n";
+    stepper.saveState(state);
+    int retries = 0;
+    double unconverged_residual = INFINITY;  // of the previous attempt, when its outer iteration stopped short
+    for (;;) {
+      std::string failure = attempt(dt);
+      const bool unconverged = failure.empty() && stepper.fluidsMove() && !step_report.ice.converged;
+      if (unconverged) failure = outerIterationFailure();
+      const bool test_undo = failure.empty() && retries == 0 && step + 1 == test_undo_step;
+      if (test_undo) failure = "undone by CFDMPM_TEST_UNDO_STEP (a test)";
+      if (failure.empty()) {
+        if (retries > 0 && !test_undo) clock.dt_previous = dt;  // the next step grows from the Δt that worked
+        break;
+      }
+      const double retry_dt = test_undo ? dt : 0.5 * dt;
+      // An outer iteration that stops no lower with half the Δt has stalled (a floor of round-off or
+      // of the upwinded fluxes) rather than diverged: a smaller step does not cure it. It is then
+      // accepted as it is when the retries run out, and the next step grows from the Δt limit as
+      // if no retry had been made, so that a scene where this is common does not shrink its Δt.
+      const bool stalled = unconverged && step_report.ice.outer_residual >= unconverged_residual;
+      if (unconverged) unconverged_residual = step_report.ice.outer_residual;
+      const bool exhausted = retries >= scene.time.step_retries || retry_dt < scene.time.dt_min;
+      if (unconverged && (exhausted || stalled)) {
+        // Counted on every rank (the report is the same on all): a checkpoint stores the count.
+        if (++clock.unconverged_warnings <= 10 && root)
+          std::cout << "  warning: step " << step + 1 << ": " << failure
+                    << "; column pressure_converged of the CSV marks such steps"
+                    << (clock.unconverged_warnings == 10 ? " (further warnings suppressed)" : "") << "\n";
+        break;
+      }
+      stepper.restoreState(state);
+      if (exhausted) giveUp(failure, retries, dt);
+      ++retries;
+      if (root)
+        std::cout << "  step " << step + 1 << " undone: " << failure << "; retry " << retries << " of "
+                  << scene.time.step_retries << " with dt = " << showNumber(retry_dt) << " s\n";
+      dt = retry_dt;
+    }
+    if (retries > 0) limit.limiter += "+retry";
     t = (t + dt > next_output - eps) ? next_output : t + dt;
     const bool output_time = t >= next_output - eps;
     ++step;
-    report(step, t, dt, limit.limiter);
+    report(step, t, dt, limit.limiter, retries);
     const bool stop = stopRequested(mpi);
     const bool last = t >= end - eps || stop || (scene.time.max_steps >= 0 && step >= scene.time.max_steps);
     if (output_time || last) writeOutput(step, t);

@@ -107,6 +107,13 @@ expect negative_checkpoint_wall_interval "$(good | sed 's/interval: 0.01}/interv
 expect no_checkpoints_kept "$(good | sed 's/interval: 0.01}/interval: 0.01, checkpoints_kept: 0}/')" \
   "cfdmpm.output.checkpoints_kept" "'0'" ">= 1"
 expect missing_key "$(good | grep -v '  time:')" "time"
+# Values as written, not as read (40.0 used to be echoed as 40, 1e-400 as 0); a repeated key named
+# with its own line (it used to be 'already exists in list "ANONYMOUS"' at the next line).
+expect echoed_as_written "$(CFL=40.0 good)" "cfdmpm.time.cfl: got '40.0'; must be in (0, 1]"
+expect below_double_range "$(good | sed 's/end_time: 0.1,/end_time: 1e-400,/')" \
+  "cfdmpm.time.end_time: got '1e-400' (read as 0: beyond the range of a double); must be > 0"
+expect repeated_key "$(good | sed 's/^  time: {end_time: 0.1, cfl: \(.*\)}$/  time: {end_time: 0.1, cfl: \1}\n  time: {end_time: 0.2}/')" \
+  ":17:3: key 'time' of cfdmpm given twice (first on line 16)"
 expect two_top_level_keys "$(good; echo 'extra: {a: 1}')" "extra"
 # Refused at set-up: by --check as by the run, with the same message.
 dry() {  # the granular column: sand alone, the fluid solver off

@@ -271,6 +271,34 @@ TEST_F(SceneTest, NegativeInfinityIsRefusedLikeInfinity)
   expectMentions(errorOf(replaced(kFullScene, "cfl: 0.4", "cfl: -.Inf")), {"cfl: got '-.Inf'", "must be finite"});
 }
 
+TEST_F(SceneTest, ValuesAreEchoedAsWritten)
+{
+  // In the file's spelling, not as the double it became (40.0, not 40).
+  expectMentions(errorOf(replaced(kFullScene, "cfl: 0.4", "cfl: 40.0")), {"cfdmpm.time.cfl: got '40.0'; must be in (0, 1]"});
+  expectMentions(errorOf(replaced(kFullScene, "viscosity: 1.0e-3", "viscosity: -1.50e-3")),
+                 {"cfdmpm.materials.water.viscosity: got '-1.50e-3'; must be >= 0"});
+  expectMentions(errorOf(replaced(kFullScene, "cells: [20, 10]", "cells: [20.0, 10]")),
+                 {"cfdmpm.domain.cells: got '[20.0, 10]' (a list of numbers)"});
+  // Beyond the range of a double, with what it became.
+  expectMentions(errorOf(replaced(kFullScene, "end_time: 0.5", "end_time: 1e-400")),
+                 {"cfdmpm.time.end_time: got '1e-400' (read as 0: beyond the range of a double); must be > 0"});
+}
+
+TEST_F(SceneTest, RepeatedKeyIsNamedWithItsLine)
+{
+  // Teuchos's reader said 'Parameter "viscosity" already exists in list "ANONYMOUS"' at the next line.
+  const std::string block =
+      errorOf(replaced(kFullScene, "      viscosity: 1.0e-3\n", "      viscosity: 1.0e-3\n      viscosity: 2.0e-3\n"));
+  expectMentions(block, {"scene.yaml:17:7: key 'viscosity' of cfdmpm.materials.water given twice (first on line 16)"});
+  EXPECT_EQ(block.find("ANONYMOUS"), std::string::npos) << block;
+  expectMentions(errorOf(replaced(kFullScene, "cfl: 0.4,", "cfl: 0.4, cfl: 0.3,")),
+                 {"scene.yaml:40:", "key 'cfl' of cfdmpm.time given twice (first on line 40)"});
+  expectMentions(errorOf(replaced(kFullScene, "  mpm: {}\n", "  mpm: {}\n  time: {end_time: 1.0}\n")),
+                 {"scene.yaml:44:3: key 'time' of cfdmpm given twice (first on line 40)"});
+  expectMentions(errorOf(replaced(kFullScene, "    air:\n", "    water:\n")),
+                 {"scene.yaml:19:5: key 'water' of cfdmpm.materials given twice (first on line 13)"});
+}
+
 TEST_F(SceneTest, NestingBeyondTheBoundIsRefusedBeforeParsing)
 {
   std::string deep = "  mpm: ";

@@ -178,10 +178,6 @@ struct LargestOutflowReducer {
   value_type* result_;
 };
 
-// The smallest room (setFluidRoom) a fluid's mass is spread over: a cell that a rigid body fills
-// holds at most a trace of fluid.
-constexpr double kRoomFloor = 1e-6;
-
 /// The limiter factor in [0, 1] for a linear profile value + φ g·r in one cell.
 /// 1. Barth–Jespersen: the profile stays within [lo, hi] (the cell's 3^Dim block) everywhere in the
 ///    cell; `spread` = Σ_d |g_d| Δx_d / 2 is the largest excursion from the centre value.
@@ -363,9 +359,6 @@ LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, d
   const auto slab_density = slab_density_;
   const int materials = materials_;
   const LocalOrdinal owned = layout_->ownedCells();
-  const bool with_room = room_ != nullptr;
-  typename Field<Dim>::ConstView room_view;
-  if (with_room) room_view = room_->view();
 
   // Per cell (owned and ghost, so that every owned face has its donor) and material, the slab
   // geometry from the cell's 2 Dim face velocities, then:
@@ -431,27 +424,11 @@ LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, d
           const double phi = limiter(value, lo, hi, spread, remaining > 0 ? remaining : 0.0, S);
           double slab_mass[2 * Dim];
           double left = value;  // the mass that stays in the cell
-          const double room = with_room ? room_view(c, 0) : 1.0;
-          if (room < 1.0) {
-            // A cell that a rigid body cuts: the fluid's density in the room the body leaves
-            // (setFluidRoom), at most all of the fluid's mass out of the cell.
-            double total = 0;
-            for (int f = 0; f < 2 * Dim; ++f) total += fraction[f];
-            double density = value / (room > kRoomFloor ? room : kRoomFloor);
-            if (total * density > value) density = value / total;
-            for (int f = 0; f < 2 * Dim; ++f) {
-              slab_mass[f] = fraction[f] * density * (capped ? outflow_share(c, f) : 1.0);
-              outflow_mass(c, f, m) = slab_mass[f];
-              if (slab_densities) slab_density(c, f, m) = density;
-              left -= slab_mass[f];
-            }
-          } else {
-            for (int f = 0; f < 2 * Dim; ++f) {
-              slab_mass[f] = fraction[f] * (value + phi * slope[f]) * (capped ? outflow_share(c, f) : 1.0);
-              outflow_mass(c, f, m) = slab_mass[f];
-              if (slab_densities) slab_density(c, f, m) = value + phi * slope[f];
-              left -= slab_mass[f];
-            }
+          for (int f = 0; f < 2 * Dim; ++f) {
+            slab_mass[f] = fraction[f] * (value + phi * slope[f]) * (capped ? outflow_share(c, f) : 1.0);
+            outflow_mass(c, f, m) = slab_mass[f];
+            if (slab_densities) slab_density(c, f, m) = value + phi * slope[f];
+            left -= slab_mass[f];
           }
           if (!(left > 0)) left = 0.0;
 

@@ -92,16 +92,6 @@ class Advector {
 
   int materials() const { return materials_; }
 
-  /// The share of each cell (one column, owned and ghost cells) that the fluids may fill: 1 minus
-  /// the rigid bodies' volume fraction; nullptr (the default): the whole cell. In a cell that a
-  /// rigid body cuts (room < 1), each fluid fills the room the body leaves, against the faces it
-  /// does not cover, and a slab carries the fluid's density in that room (first order): a sliver of
-  /// water between a piston's face and the cell face ahead leaves through that face at the piston's
-  /// speed. The linear profile of the whole cell would give that face a few per cent of water, and
-  /// the pressure equation would drive it out tens of times faster (doc/mpmice.md). The field must
-  /// outlive the calls.
-  void setFluidRoom(const Field<Dim>* room) { room_ = room; }
-
 
  /// At most this many mass-specific fields per advect() call (each of any width).
   static constexpr int kMaxFields = 8;
@@ -117,7 +107,6 @@ class Advector {
   std::shared_ptr<const Layout<Dim>> layout_;
   int materials_;
   Options options_;
-  const Field<Dim>* room_ = nullptr;  // setFluidRoom
   // Per local cell: the local ids of its 3^Dim block (itself included), the cell's own id where
   // there is none held by this rank; built once, read by the limiter bounds.
   Kokkos::View<LocalOrdinal**, MemorySpace> block_;

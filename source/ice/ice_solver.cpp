@@ -131,7 +131,6 @@ IceSolver<Dim>::IceSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>>
       corrected_face_velocity_(layout, materials_, "corrected_face_velocity"),
       face_specific_volume_(layout, materials_, "face_specific_volume"),
       face_beta_(layout, 1, "face_beta"),
-      fluid_room_(layout, Location::Cell, 1, "fluid_room"),
       solid_face_share_(layout, solids.empty() ? 1 : 2 * materials_, "solid_face_share"),
       solid_volume_change_(layout, Location::Cell, materials_, "solid_volume_change"),
       solid_kinematic_velocity_(layout, solids.empty() ? 1 : materials_, "solid_kinematic_velocity"),
@@ -189,9 +188,6 @@ IceSolver<Dim>::IceSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>>
   pressure_solver_ = std::make_unique<PressureSolver<Dim>>(layout, settings_.linear_solver);
   for (const char* phase : kPhases) timers_[phase] = Teuchos::TimeMonitor::getNewCounter(std::string("ice: ") + phase);
   advector_ = std::make_unique<Advector<Dim>>(layout, materials_);
-  fluid_room_.fill(1.0);
-  for (int m = 0; m < materials_; ++m)
-    if (roles_.rigid[m]) advector_->setFluidRoom(&fluid_room_);
 }
 
 template <int Dim>
@@ -321,17 +317,7 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
               beta(c, 0) = 0.0;
               return;
             }
-            // A cell that rigid bodies fill alone has the pressure of their stiffness about its
-            // reference (the initial state's), no fluid's: across the face that a moving body opens
-            // behind it (the fluid that follows it flows in through it) it would drive the fluids
-            // at tens of m/s before the pressure equation. There the equation alone sets it.
-            double pressure_difference = p(c, 0) - p(l, 0);
-            if (with_solids) {
-              double room_l = 0, room_r = 0;
-              for (int m = 0; m < nm; ++m)
-                if (!roles.rigid[m]) room_l += theta(l, m), room_r += theta(c, m);
-              if (!(room_l > 0) || !(room_r > 0)) pressure_difference = 0.0;
-            }
+            const double pressure_difference = p(c, 0) - p(l, 0);
             ice::MaterialArray<double> tl{}, tr{}, vl{}, vr{}, vel{}, sv{}, own{};
             for (int m = 0; m < nm; ++m) {
               tl[m] = theta(l, m), tr[m] = theta(c, m), vl[m] = v(l, m), vr[m] = v(c, m);
@@ -450,51 +436,6 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
   }
 }
 
-// [5] With solids in the cells, the pressure matrix's face coefficient β = Σ_m v_f,m θ_m with the
-// volume fraction θ_m that each material's flux carries (pressureRightHandSide): a fluid's from
-// fluidFaceFractions, a deformable solid's share of the face, none for a rigid body. The flux
-// takes the upwind side's. faceVelocities' mean of the two sides, Σ v_f (θ_L + θ_R) / 2, is half
-// the flux's response where a fluid fills the donor and is absent from the receiver (the air that
-// flows into the room a moving rigid body leaves behind it): there the outer iteration overshot by
-// the whole correction every time and never converged, its residual stuck at the body's volume
-// change per step. Before the first correction (`upwind` false) the side is not known (at rest the
-// face velocity's sign is noise, and the empty side would decouple the face): the larger fraction,
-// which never assumes less response than the flux has, so the iteration contracts. After it, the
-// upwind side of the corrected face velocity, or the mean where that is larger: exact while the
-// flow keeps its direction and, where it reverses, an overshoot of at most the correction (the
-// larger fraction throughout converged by only 0.7 per iteration where a cut cell's 30 % of air
-// flows into a cell full of it). Fluids alone keep the mean.
-template <int Dim>
-void IceSolver<Dim>::fluxFaceBeta(bool upwind)
-{
-  const int n = materials_;
-  const auto neighbours = layout_->cellNeighbours();
-  const auto roles = roles_;
-  for (int d = 0; d < Dim; ++d) {
-    const auto uf = face_velocity_.direction(d).view();
-    const auto vf = face_specific_volume_.direction(d).view();
-    const auto fluid = fluid_face_fraction_.direction(d).view();
-    const auto share = solid_face_share_.direction(d).view();
-    auto beta = face_beta_.direction(d).view();
-    Kokkos::parallel_for(
-        "ice::fluxFaceBeta", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->overlapCells()),
-        KOKKOS_LAMBDA(const LocalOrdinal c) {
-          if (neighbours(c, 2 * d) < 0) return;  // a wall, or a ghost's outer face: as faceVelocities left it
-          double b = 0;
-          for (int m = 0; m < n; ++m) {
-            if (roles.rigid[m]) continue;
-            const double below = roles.lagrangian[m] ? Kokkos::Experimental::fmin(1.0, share(c, 2 * m)) : fluid(c, 2 * m);
-            const double above =
-                roles.lagrangian[m] ? Kokkos::Experimental::fmin(1.0, share(c, 2 * m + 1)) : fluid(c, 2 * m + 1);
-            const double carried = upwind ? Kokkos::Experimental::fmax(uf(c, m) > 0 ? below : above, 0.5 * (below + above))
-                                          : Kokkos::Experimental::fmax(below, above);
-            b += vf(c, m) * carried;
-          }
-          beta(c, 0) = b > 0 ? b : 0.0;  // a fraction at round-off below zero closes the face
-        });
-  }
-}
-
 // [5] Right-hand side of the pressure equation, −Δt Σ_faces A Σ_m θ_upwind,m u_f,m · n_out
 // − V κ Σδp (the outer-iteration residual form of Uintah's setupRHS), plus the solids' own change
 // of volume V Σ_s Δθ_s (solidVolumeChange); returns max |rhs| / V.
@@ -555,10 +496,8 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
           // it) at face velocity w, per face area: a fluid's upwind volume fraction (with solids:
           // the advection's, fluidFaceFractions) times w; for a solid, the difference between what
           // w and the particles' own face velocity carry across with its upwind share of the face
-          // (their own motion is in solidVolumeChange). A rigid body moves as its particles do and
-          // takes no correction: all of its volume's motion is in solidVolumeChange.
+          // (their own motion is in solidVolumeChange).
           const auto flux = [&](int d, int m, LocalOrdinal upper, LocalOrdinal lower, double w) {
-            if (roles.rigid[m]) return 0.0;
             if (roles.lagrangian[m]) {
               const auto crossing = [&](double velocity) {
                 return velocity * Kokkos::Experimental::fmin(1.0, share[d](upper, velocity > 0 ? 2 * m : 2 * m + 1));
@@ -907,24 +846,8 @@ void IceSolver<Dim>::pressurePhase(CellState<Dim>& state, double dt, IceStepRepo
   Teuchos::TimeMonitor phase(*timers_.at("pressure"));
   sum_delta_p_.fill(0.0);
   const bool implicit = settings_.pressure == "implicit";
-  if (roles_.any_solid) {
-    // The room the rigid bodies leave in each cell (owned and ghost), for this step's fluid face
-    // fractions and advection.
-    const auto theta = state.volume_fraction.view();
-    auto room = fluid_room_.view();
-    const auto roles = roles_;
-    const int n = materials_;
-    Kokkos::parallel_for(
-        "ice::fluidRoom", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->overlapCells()), KOKKOS_LAMBDA(const LocalOrdinal c) {
-          double rigid = 0;
-          for (int m = 0; m < n; ++m)
-            if (roles.rigid[m]) rigid += theta(c, m);
-          room(c, 0) = rigid > 0 ? Kokkos::Experimental::fmax(0.0, 1.0 - rigid) : 1.0;
-        });
-    fluidFaceFractions(state, dt);
-    fluxFaceBeta(false);
-  }
   if (implicit) pressure_solver_->assemble(mixture_compressibility_, face_beta_, dt);
+  if (roles_.any_solid) fluidFaceFractions(state, dt);
   double residual = pressureRightHandSide(state, dt, false);
   while (residual > settings_.outer_tolerance && report.outer_iterations < settings_.max_outer_iterations) {
     ++report.outer_iterations;
@@ -975,22 +898,6 @@ void IceSolver<Dim>::pressurePhase(CellState<Dim>& state, double dt, IceStepRepo
     }
     // p = p_eq + Σδp and the faces corrected with this iteration's δp, then the new residual.
     residual = pressureRightHandSide(state, dt, true);
-    if (roles_.any_solid) {
-      // The fluids' face fractions for the corrected face velocities, as the advection will move
-      // the fluids, and the residual with them. Fractions kept from the uncorrected velocities
-      // differ from the advection's by the correction times the profile's slope; next to a solid a
-      // water volume that arrives unforeseen is a pressure of K_water times it at the next
-      // equilibration, whose gradient the next correction undoes, a larger difference again: with a
-      // piston pushing water through its cut cells this grew tenfold per step (doc/mpmice.md).
-      fluidFaceFractions(state, dt);
-      residual = pressureRightHandSide(state, dt, false);
-      // Now that the corrected face velocities say which side each flux comes from, the matrix
-      // takes the fractions the fluxes carry (fluxFaceBeta).
-      if (implicit && residual > settings_.outer_tolerance) {
-        fluxFaceBeta(true);
-        pressure_solver_->assemble(mixture_compressibility_, face_beta_, dt);
-      }
-    }
   }
   report.outer_residual = residual;
   report.converged = residual <= settings_.outer_tolerance || !implicit;

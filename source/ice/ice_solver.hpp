@@ -172,7 +172,6 @@ class IceSolver {
   void faceVelocities(const CellState<Dim>& state, double dt);
   double pressureRightHandSide(CellState<Dim>& state, double dt, bool after_solve);
   void fluidFaceFractions(const CellState<Dim>& state, double dt);
-  void fluxFaceBeta(bool upwind);
   void energy(CellState<Dim>& state, const Field<Dim>& old_specific_volume, double dt);
 
   Scene scene_;
@@ -198,7 +197,6 @@ class IceSolver {
   FaceField<Dim> corrected_face_velocity_;  // work array of the pressure correction
   FaceField<Dim> face_specific_volume_; // per material, after the face exchange
   FaceField<Dim> face_beta_;            // Σ θ_f v_f
-  Field<Dim> fluid_room_;               // 1 − the rigid bodies' volume fraction (Advector::setFluidRoom)
   FaceField<Dim> solid_face_share_;     // solidFaceShares()
   Field<Dim> solid_volume_change_;      // solidVolumeChange()
   FaceField<Dim> solid_kinematic_velocity_;  // a solid's face velocity before pressure and exchange

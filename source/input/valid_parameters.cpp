@@ -345,10 +345,7 @@ RCP<ParameterList> buildSolidModel(const std::string& type)
            "(through triaxial compression), inner_cone (through triaxial extension).",
            oneOf({"plane_strain", "outer_cone", "inner_cone"}));
   } else {
-    define(*model, "velocity", zeros(2),
-           "Velocity of the rigid body, constant in time: its particles move at it from the start, whatever "
-           "the forces on them (a region's `velocity` does not apply to them). A piston or a gate that is "
-           "pushed; zero for a bed.",
+    define(*model, "velocity", zeros(2), "Velocity of the rigid body.",
            derivedDefault(perDirection(unit("m/s")), "zero"));
   }
   return model;

@@ -702,32 +702,14 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt)
     }
     // Face shares: the particle's volume in the layers of width kFaceLayer cells just below and
     // just above each interior face its box reaches, per volume of the layer.
-    // A rigid particle that moves across the faces of direction d (prescribed velocity) instead gives
-    // both sides the share of the step during which its box covers the face itself: a uniformly
-    // moving body then closes a face exactly while it covers it, and the fluid crosses the rest of
-    // the step at the body's speed, on its leading face (the fluid it pushes out of a cell) as on its
-    // trailing face (the fluid that fills the room it leaves). The layers would close the trailing
-    // face until the body is kFaceLayer past it, with no way for fluid into the room behind it.
     for (int d = 0; d < Dim; ++d) {
       const double lo = (xp[d] - lp[d] - origin[d]) / spacing[d], hi = (xp[d] + lp[d] - origin[d]) / spacing[d];
       const double per_length = Vp / ((hi - lo) * kFaceLayer * cell_volume);
-      const double sweep = table.rigid[m] ? dt * velocity[d] / spacing[d] : 0.0;  // travel in the step, cells
-      const bool swept = sweep != 0.0;
-      const double reach = swept ? math::max(kFaceLayer, math::abs(sweep)) : kFaceLayer;
-      const long long first_face = -(long long)math::floor(reach - lo), last_face = (long long)math::floor(hi + reach);
+      const long long first_face = -(long long)math::floor(kFaceLayer - lo), last_face = (long long)math::floor(hi + kFaceLayer);
       for (long long f = first_face; f <= last_face; ++f) {
         if (f < 1 || f > count[d] - 1) continue;  // domain faces are walls
-        double below, above;
-        if (swept) {
-          // The box covers face f while its shift s in [min(0, sweep), max(0, sweep)] lies in
-          // [f − hi, f − lo]; the share of the step, in the layers' units.
-          const double s0 = math::min(0.0, sweep), s1 = math::max(0.0, sweep);
-          const double covered = math::max(0.0, math::min(s1, f - lo) - math::max(s0, f - hi)) / (s1 - s0);
-          below = above = covered * kFaceLayer;
-        } else {
-          below = math::max(0.0, math::min(hi, double(f)) - math::max(lo, f - kFaceLayer));
-          above = math::max(0.0, math::min(hi, f + kFaceLayer) - math::max(lo, double(f)));
-        }
+        const double below = math::max(0.0, math::min(hi, double(f)) - math::max(lo, f - kFaceLayer));
+        const double above = math::max(0.0, math::min(hi, f + kFaceLayer) - math::max(lo, double(f)));
         if (below <= 0 && above <= 0) continue;
         overlap.acrossDirection(d, [&](long long ijk[3], double w) {
           ijk[d] = f;

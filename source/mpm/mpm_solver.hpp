@@ -137,8 +137,6 @@ class MpmSolver {
   /// the face on a body's surface is covered on the body's side only, and a face that a front has
   /// not reached is not covered, however full the cell behind it: what crosses a face in a step is
   /// the share of the layer upstream of it (times u Δt), not the upstream cell's volume fraction.
-  /// A rigid material moving across the faces of a direction gives both sides of those faces
-  /// instead the part of the step Δt during which its particles' boxes cover the face itself.
   /// Summed across ranks: the owned cells are complete, and so are the ghosts.
   /// With dt > 0 also the volume each material would have in every cell if each particle moved by
   /// Δt ṽ_p (predictedVolumeColumn): how the solids' volumes move in a step before the fluid

@@ -57,22 +57,8 @@ if [ "$restart_ranks" = "$ranks" ]; then
   done < "$work/files.A"
   echo "$(wc -l < "$work/files.A") files compared byte for byte (B's own checkpoints by content), $different differ"
   for f in $(cd "$work/A" && ls checkpoints); do
-    "$PYTHON" - "$work/A/checkpoints/$f" "$work/B/checkpoints/$f" <<'PY' || fail "checkpoint $f differs in content"
-import sys
-import h5py
-import numpy as np
-a, b = (h5py.File(p, "r") for p in sys.argv[1:])
-def items(f):
-    out = {}
-    f.visititems(lambda name, obj: out.__setitem__(name, obj[...]) if isinstance(obj, h5py.Dataset) else None)
-    return out
-attributes = lambda f: {k: v for k, v in f.attrs.items() if k not in ("scene", "scene_path")}
-da, db = items(a), items(b)
-same = da.keys() == db.keys() and all(np.array_equal(da[k], db[k]) for k in da)
-aa, ab = attributes(a), attributes(b)
-same = same and aa.keys() == ab.keys() and all(np.array_equal(aa[k], ab[k]) for k in aa)
-sys.exit(0 if same else 1)
-PY
+    "$PYTHON" "$SOURCE_DIR/test/app/same_checkpoint.py" "$work/A/checkpoints/$f" "$work/B/checkpoints/$f" ||
+      fail "checkpoint $f differs in content"
   done
   [ "$different" = 0 ] || fail "$different files differ between the run that never stopped and the restarted one"
   "$PYTHON" "$SOURCE_DIR/utilities/compare_runs.py" "$work/A" "$work/B" --tolerance 0 || fail "compare_runs.py --tolerance 0"

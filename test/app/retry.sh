@@ -99,23 +99,8 @@ elif [ "$mode" = undo ]; then
   [ "$files" -gt 1 ] && [ "$different" = 0 ] || fail "the step files differ"
   # Checkpoints by content: their attributes scene and scene_path name each run's own directory.
   for f in $(cd "$work/A" && ls checkpoints); do
-    "$PYTHON" - "$work/A/checkpoints/$f" "$work/U/checkpoints/$f" <<'PY' || fail "checkpoint $f differs in content"
-import sys
-import h5py
-import numpy as np
-a, b = (h5py.File(p, "r") for p in sys.argv[1:])
-def items(f):
-    out = {}
-    f.visititems(lambda name, obj: out.__setitem__(name, obj[...]) if isinstance(obj, h5py.Dataset) else None)
-    return out
-attributes = lambda f: {k: v for k, v in f.attrs.items() if k not in ("scene", "scene_path")}
-da, db = items(a), items(b)
-same = da.keys() == db.keys() and all(np.array_equal(da[k], db[k]) for k in da)
-aa, ab = attributes(a), attributes(b)
-same = same and aa.keys() == ab.keys() and all(np.array_equal(aa[k], ab[k]) for k in aa)
-print(f"checkpoint {sys.argv[1].split('/')[-1]}: {len(da)} datasets and {len(aa)} attributes " + ("equal" if same else "DIFFER"))
-sys.exit(0 if same else 1)
-PY
+    "$PYTHON" "$SOURCE_DIR/test/app/same_checkpoint.py" "$work/A/checkpoints/$f" "$work/U/checkpoints/$f" ||
+      fail "checkpoint $f differs in content"
   done
   "$PYTHON" - "$work/A/scene.csv" "$work/U/scene.csv" "$undo" <<'PY' || fail "the CSVs differ"
 import csv, sys

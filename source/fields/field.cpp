@@ -83,6 +83,16 @@ void Field<Dim>::repartition(std::shared_ptr<const Layout<Dim>> new_layout)
   exchangeHalo();
 }
 
+template <int Dim>
+void Field<Dim>::importOwned(const Field& source)
+{
+  if (source.location_ != location_ || source.columns() != columns())
+    throw std::invalid_argument("Field::importOwned: '" + source.name_ + "' and '" + name_ +
+                                "' differ in location or columns");
+  const typename Layout<Dim>::Import move(source.ownedMap(), ownedMap());
+  owned_->doImport(*source.owned_, move, Tpetra::INSERT);
+}
+
 template class Field<2>;
 template class Field<3>;
 

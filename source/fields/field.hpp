@@ -52,6 +52,11 @@ class Field {
   /// Moves the owned values to a new layout (new partition of the same grid) and refreshes ghosts.
   void repartition(std::shared_ptr<const Layout<Dim>> new_layout);
 
+  /// Takes the owned values of `source`, a field of the same grid, location and columns on another
+  /// layout (another partition), through a Tpetra Import between the owned maps. Ghosts are left
+  /// as they were (exchangeHalo refreshes them).
+  void importOwned(const Field& source);
+
   /// Exchanges the values (owned and ghost) with `other`, a field of the same layout, location and
   /// column count, without copying: a kernel can write new values into a second field and then
   /// make them this field's. Names stay with their fields.

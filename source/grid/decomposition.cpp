@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -108,7 +109,56 @@ std::vector<double> rankLoads(const Decomposition& decomposition, const std::vec
   return load;
 }
 
+Decomposition closestNumbering(const Decomposition& division, const Decomposition& current,
+                               const std::vector<double>& patch_weight)
+{
+  if (division.ranks != current.ranks || division.patch_owner.size() != current.patch_owner.size())
+    throw std::invalid_argument("closestNumbering: the divisions differ in ranks or patches");
+  // The work each (new part, current rank) pair shares, for the pairs that share any.
+  std::map<std::pair<int, int>, double> shared;
+  for (std::size_t p = 0; p < division.patch_owner.size(); ++p)
+    shared[{division.patch_owner[p], current.patch_owner[p]}] += patch_weight[p];
+  std::vector<std::pair<std::pair<int, int>, double>> pairs(shared.begin(), shared.end());
+  std::stable_sort(pairs.begin(), pairs.end(), [](const auto& a, const auto& b) { return a.second > b.second; });
+  const int ranks = division.ranks;
+  std::vector<int> rank_of_part(ranks, -1);
+  std::vector<bool> taken(ranks, false);
+  for (const auto& [pair, work] : pairs)
+    if (rank_of_part[pair.first] < 0 && !taken[pair.second]) {
+      rank_of_part[pair.first] = pair.second;
+      taken[pair.second] = true;
+    }
+  // Parts that share nothing with a free rank take the free ranks in order.
+  int next_free = 0;
+  for (int part = 0; part < ranks; ++part)
+    if (rank_of_part[part] < 0) {
+      while (taken[next_free]) ++next_free;
+      rank_of_part[part] = next_free;
+      taken[next_free] = true;
+    }
+  Decomposition renumbered = division;
+  for (int& owner : renumbered.patch_owner) owner = rank_of_part[owner];
+  return renumbered;
+}
+
+double loadImbalance(const std::vector<double>& load)
+{
+  const double mean = std::accumulate(load.begin(), load.end(), 0.0) / double(load.size());
+  return mean > 0 ? *std::max_element(load.begin(), load.end()) / mean - 1.0 : 0.0;
+}
+
+template <int Dim>
+std::vector<double> patchWork(const Grid<Dim>& grid, const std::vector<long long>& particles, double particle_work)
+{
+  std::vector<double> work(grid.patchCount());
+  for (int p = 0; p < grid.patchCount(); ++p)
+    work[p] = double(grid.patchCells(p).count()) + (particles.empty() ? 0.0 : particle_work * double(particles[p]));
+  return work;
+}
+
 template Decomposition partitionPatches<2>(const Grid<2>&, int, const std::vector<double>&);
 template Decomposition partitionPatches<3>(const Grid<3>&, int, const std::vector<double>&);
+template std::vector<double> patchWork(const Grid<2>&, const std::vector<long long>&, double);
+template std::vector<double> patchWork(const Grid<3>&, const std::vector<long long>&, double);
 
 }  // namespace cfdmpm

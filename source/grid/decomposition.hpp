@@ -32,4 +32,21 @@ Decomposition partitionPatches(const Grid<Dim>& grid, int ranks,
 std::vector<double> rankLoads(const Decomposition& decomposition,
                               const std::vector<double>& patch_weight);
 
+/// `division` with its parts renumbered so that as much work as possible stays where `current`
+/// has it: METIS numbers the parts of a new partition without regard to an earlier one, and a
+/// rebalance should move only what it must. Parts are matched greedily, the pair (part, rank)
+/// sharing the most work first. Deterministic, like partitionPatches.
+Decomposition closestNumbering(const Decomposition& division, const Decomposition& current,
+                               const std::vector<double>& patch_weight);
+
+/// The heaviest rank's load over the mean load, minus one: 0 when the ranks are balanced, 0.5 when
+/// the slowest rank has half as much again as the mean (and the step takes 1.5 times as long as
+/// a balanced one would).
+double loadImbalance(const std::vector<double>& load);
+
+/// The work of every patch in units of one cell's: its cells, plus `particle_work` per particle
+/// (`particles` indexed by patch id; empty: no particles).
+template <int Dim>
+std::vector<double> patchWork(const Grid<Dim>& grid, const std::vector<long long>& particles, double particle_work);
+
 }  // namespace cfdmpm

@@ -668,6 +668,7 @@ DomainSpec readDomain(ParameterList& list)
   for (int i = 0; i < 3; ++i) domain.patch_cells[i] = std::min(domain.patch_cells[i], domain.cells[i]);
   domain.ghost_width = list.get<int>("ghost_width");
   domain.gravity = padded<double>(list.get<Array<double>>("gravity"), 0.0);
+  domain.rebalance_interval = list.get<int>("rebalance_interval");
 
   for (int i = 0; i < dimension; ++i) {
     if (!(domain.upper[i] > domain.lower[i])) {

@@ -21,6 +21,7 @@ struct DomainSpec {
   std::array<long long, 3> patch_cells{1, 1, 1};  // patch size in cells, at most `cells`; unused dimensions 1
   int ghost_width = 2;                        // ghost cell layers around each rank's cells
   std::array<double, 3> gravity{0, 0, 0};     // m/s^2
+  int rebalance_interval = 0;                 // steps between decompositions with particle weights; 0 never
 };
 
 struct MaterialSpec {

@@ -1048,6 +1048,38 @@ long long MpmSolver<Dim>::particleCount() const
 }
 
 template <int Dim>
+std::vector<long long> MpmSolver<Dim>::particlesPerPatch() const
+{
+  const Grid<Dim>& grid = layout_->grid();
+  const int patches = grid.patchCount();
+  Kokkos::View<long long*, MemorySpace> counts("particles per patch", std::size_t(patches));
+  const auto position = particles_.position;
+  const Box first_patch = grid.patchCells(0);  // patches are full size except the last per direction
+  double lower[Dim], spacing[Dim];
+  long long cells[Dim], patch_cells[Dim], patch_counts[Dim];
+  for (int d = 0; d < Dim; ++d) {
+    lower[d] = grid.lower()[d], spacing[d] = grid.spacing()[d], cells[d] = grid.cells()[d];
+    patch_cells[d] = first_patch.extent(d), patch_counts[d] = grid.patchCounts()[d];
+  }
+  Kokkos::parallel_for(
+      "mpm::particlesPerPatch", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count), KOKKOS_LAMBDA(const int p) {
+        long long patch = 0, stride = 1;
+        for (int d = 0; d < Dim; ++d) {
+          // Between steps every particle is inside the domain (relocateParticles checked it).
+          long long c = static_cast<long long>(math::floor((position(p, d) - lower[d]) / spacing[d]));
+          c = c < 0 ? 0 : (c >= cells[d] ? cells[d] - 1 : c);
+          patch += (c / patch_cells[d]) * stride;
+          stride *= patch_counts[d];
+        }
+        Kokkos::atomic_add(&counts(patch), 1LL);
+      });
+  const auto host = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), counts);
+  std::vector<long long> local(host.data(), host.data() + patches), total(std::size_t(patches), 0);
+  Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_SUM, patches, local.data(), total.data());
+  return total;
+}
+
+template <int Dim>
 std::vector<double> MpmSolver<Dim>::materialMasses() const
 {
   const int nm = int(materials_.size());

@@ -174,6 +174,9 @@ class MpmSolver {
 
   // --- diagnostics (collective) ------------------------------------------------------------------
   long long particleCount() const;
+  /// Particles in every patch of the grid (indexed by patch id), over all ranks: the particles'
+  /// share of the work when the decomposition is redone.
+  std::vector<long long> particlesPerPatch() const;
   std::vector<double> materialMasses() const;   ///< per MPM material (kg, or kg/m in 2-D)
   double kineticEnergy() const;                 ///< sum of m |v|^2 / 2 (J, or J/m in 2-D)
   std::array<double, 3> momentum() const;       ///< sum of m v (entries beyond Dim zero)

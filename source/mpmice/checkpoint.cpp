@@ -4,6 +4,7 @@
 #include "io/hdf5_reader.hpp"
 #include "io/output_directory.hpp"
 #include "io/xdmf_writer.hpp"
+#include "mpmice/run_state.hpp"
 #include "mpmice/state_output.hpp"
 
 #include <filesystem>
@@ -15,17 +16,6 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr const char* kFormat = "cfdmpm checkpoint 1";
-
-/// The cell fields of the coupled state, by the name they have in the checkpoint.
-template <class State>  // CellState<Dim>, const or not
-auto stateFields(State& state)
-{
-  using FieldPointer = decltype(&state.density);
-  return std::vector<std::pair<std::string, FieldPointer>>{
-      {"state/volume_fraction", &state.volume_fraction}, {"state/density", &state.density},
-      {"state/specific_volume", &state.specific_volume}, {"state/velocity", &state.velocity},
-      {"state/temperature", &state.temperature},         {"state/pressure", &state.pressure}};
-}
 
 /// Names of the columns of Particles::pack, in its order.
 template <int Dim>
@@ -95,6 +85,7 @@ CheckpointHeader readCheckpointHeader(MPI_Comm comm, const std::string& path)
   header.step = in.attributeInteger("step");
   header.time = in.attributeDouble("time");
   header.ranks = int(in.attributeInteger("ranks"));
+  for (long long owner : in.attributeIntegers("decomposition")) header.decomposition.push_back(int(owner));
   return header;
 }
 
@@ -159,8 +150,8 @@ std::string CheckpointWriter<Dim>::write(const RunClock& clock, const CellState<
   hdf5_->writeAttribute("unconverged_warnings", static_cast<long long>(clock.unconverged_warnings));
   hdf5_->writeAttribute("output_steps", stepRecordsText(output_steps));
 
-  for (const auto& [name, field] : stateFields(state)) writeField(*field, name);
-  if (const IceSolver<Dim>* fluids = stepper.fluids()) writeField(fluids->solidReferencePressure(), "ice/solid_reference_pressure");
+  for (const auto& [name, field] : namedFields(state)) writeField(*field, name);
+  if (const IceSolver<Dim>* fluids = stepper.fluids()) writeField(fluids->solidReferencePressure(), kSolidReferencePressureName);
 
   if (const mpm::MpmSolver<Dim>* solids = stepper.particles()) {
     const mpm::Particles<Dim>& particles = solids->particles();
@@ -186,19 +177,18 @@ std::string CheckpointWriter<Dim>::write(const RunClock& clock, const CellState<
 }
 
 template <int Dim>
-RunClock readCheckpoint(const std::string& path, std::shared_ptr<const Layout<Dim>> layout_pointer, CellState<Dim>& state,
-                        MpmIceStep<Dim>& stepper, std::vector<WrittenStep>& output_steps)
+RunClock readCheckpoint(const std::string& path, RunState<Dim>& run, std::vector<WrittenStep>& output_steps)
 {
-  const Layout<Dim>& layout = *layout_pointer;
+  const Layout<Dim>& layout = *run.layout;
   const MPI_Comm comm = rawMpiComm(layout.comm());
   Hdf5Reader in(comm, path);
   if (!in.hasAttribute("format") || in.attributeText("format") != kFormat)
     throw InputError("checkpoint '" + path + "': not a cfdmpm checkpoint");
 
-  // 1. Cell fields: owned entries from the file, ghosts from their owners.
+  // 1. Cell fields: owned entries from the file (adoptState fills the ghosts from their owners).
   const OutputLayout cells = outputLayout(layout.grid(), Location::Cell, layout.ownedCellBoxes());
   std::vector<double> buffer;
-  auto load = [&](Field<Dim>& field, const std::string& name) {
+  auto load = [&](const std::string& name, Field<Dim>& field) {
     const int columns = field.columns();
     const LocalOrdinal n = field.ownedCount();
     buffer.resize(std::size_t(n) * columns);
@@ -206,24 +196,20 @@ RunClock readCheckpoint(const std::string& path, std::shared_ptr<const Layout<Di
     auto v = field.view();
     for (LocalOrdinal l = 0; l < n; ++l)
       for (int c = 0; c < columns; ++c) v(l, c) = buffer[std::size_t(l) * columns + c];
-    field.exchangeHalo();
   };
-  for (const auto& [name, field] : stateFields(state)) load(*field, name);
-  if (IceSolver<Dim>* fluids = stepper.fluids()) {
-    Field<Dim> reference(layout_pointer, Location::Cell, 1, "solid_reference_pressure");
-    load(reference, "ice/solid_reference_pressure");
-    fluids->setSolidReferencePressure(reference);
-  }
 
   // 2. Particles: on as many ranks as wrote them, each rank its own block in its order (what makes
-  //    the restart bit for bit); otherwise equal shares, then each particle to its cell's owner.
-  if (mpm::MpmSolver<Dim>* solids = stepper.particles()) {
+  //    the restart bit for bit); otherwise equal shares. adoptState sends each particle to its
+  //    cell's owner.
+  typename mpm::MpmSolver<Dim>::ParticleSnapshot particles;
+  long long rows = 0;
+  if (run.step->particles()) {
     constexpr int K = mpm::Particles<Dim>::kPackedSize;
     if (in.attributeText("particle_columns") != particleColumns<Dim>())
       throw InputError("checkpoint '" + path + "': its particle columns are not those of this version");
     const std::vector<long long> counts = in.attributeIntegers("particle_rank_counts");
     const int rank = layout.comm()->getRank(), ranks = layout.comm()->getSize();
-    long long total = 0, first = 0, rows = 0;
+    long long total = 0, first = 0;
     for (long long c : counts) total += c;
     if (int(counts.size()) == ranks) {
       for (int r = 0; r < rank; ++r) first += counts[r];
@@ -232,19 +218,14 @@ RunClock readCheckpoint(const std::string& path, std::shared_ptr<const Layout<Di
       first = total * rank / ranks;
       rows = total * (rank + 1) / ranks - first;
     }
-    buffer.resize(std::size_t(rows) * K);
-    in.readRows("/particles/packed", first, rows, K, buffer.data());
-    mpm::Particles<Dim>& particles = solids->particles();
-    particles.resize(int(rows));
+    std::vector<double> packed(std::size_t(rows) * K);
+    in.readRows("/particles/packed", first, rows, K, packed.data());
+    particles = typename mpm::MpmSolver<Dim>::ParticleSnapshot("checkpoint particles", std::size_t(rows), K);
     Kokkos::View<double**, Kokkos::LayoutRight, Kokkos::HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>> host(
-        buffer.data(), std::size_t(rows), K);
-    const auto packed = Kokkos::create_mirror_view_and_copy(MemorySpace(), host);
-    Kokkos::parallel_for(
-        "checkpoint::unpack", Kokkos::RangePolicy<ExecutionSpace>(0, int(rows)),
-        KOKKOS_LAMBDA(const int p) { particles.unpack(&packed(p, 0), p); });
-    Kokkos::fence();
-    solids->relocateParticles();
+        packed.data(), std::size_t(rows), K);
+    Kokkos::deep_copy(particles, host);
   }
+  adoptState<Dim>(load, particles, int(rows), run);
 
   // 3. The driver's clock and the records of the step files written so far.
   RunClock clock;
@@ -264,9 +245,7 @@ RunClock readCheckpoint(const std::string& path, std::shared_ptr<const Layout<Di
 
 template class CheckpointWriter<2>;
 template class CheckpointWriter<3>;
-template RunClock readCheckpoint(const std::string&, std::shared_ptr<const Layout<2>>, CellState<2>&, MpmIceStep<2>&,
-                                 std::vector<WrittenStep>&);
-template RunClock readCheckpoint(const std::string&, std::shared_ptr<const Layout<3>>, CellState<3>&, MpmIceStep<3>&,
-                                 std::vector<WrittenStep>&);
+template RunClock readCheckpoint(const std::string&, RunState<2>&, std::vector<WrittenStep>&);
+template RunClock readCheckpoint(const std::string&, RunState<3>&, std::vector<WrittenStep>&);
 
 }  // namespace cfdmpm

@@ -16,7 +16,8 @@
 //
 // Written like the step files (a temporary name, renamed once every rank has closed it): a
 // checkpoint with its final name is complete. What else a step depends on is rebuilt the same way
-// on restart: the grid and its METIS decomposition (from the scene and the rank count), the
+// on restart: the grid (from the scene) and its decomposition (the checkpoint's on as many ranks,
+// which a rebalance may have made differ from the first; otherwise METIS for the new count), the
 // particle bins (from the particles), node fields (every step starts from the particles), and the
 // pressure solver's preconditioner: writing a checkpoint makes the next solve build a fresh MueLu
 // hierarchy in the running run too (IceSolver::restartPreconditionerSchedule), so both continue
@@ -24,6 +25,7 @@
 #include "fields/cell_state.hpp"
 #include "io/hdf5_writer.hpp"
 #include "mpmice/mpmice_step.hpp"
+#include "mpmice/run_state.hpp"
 
 #include <mpi.h>
 
@@ -53,6 +55,7 @@ struct CheckpointHeader {
   long long step = 0;
   double time = 0;
   int ranks = 0;
+  std::vector<int> decomposition;  // the rank of every patch when the checkpoint was written
 };
 
 /// The checkpoint to restart from: `file_or_directory` itself, or the newest checkpoint in
@@ -90,14 +93,13 @@ class CheckpointWriter {
   std::vector<double> buffer_;
 };
 
-/// Loads a checkpoint into a freshly built state and coupled step (every rank, collective): cell
-/// fields with their halos, the fluid solver's solid reference pressure, the particles (on the
-/// same number of ranks each rank gets back its own, in their order; otherwise they go to the
-/// owners of their cells). Returns the driver's clock; `output_steps` gets the records of the
-/// step files written up to the checkpoint.
+/// Loads a checkpoint into a run state freshly built by buildRunState (every rank, collective),
+/// through adoptState: cell fields with their halos, the fluid solver's solid reference pressure,
+/// the particles (on the same number of ranks each rank gets back its own, in their order;
+/// otherwise they go to the owners of their cells). Returns the driver's clock; `output_steps` gets
+/// the records of the step files written up to the checkpoint.
 template <int Dim>
-RunClock readCheckpoint(const std::string& path, std::shared_ptr<const Layout<Dim>> layout_pointer, CellState<Dim>& state,
-                        MpmIceStep<Dim>& stepper, std::vector<WrittenStep>& output_steps);
+RunClock readCheckpoint(const std::string& path, RunState<Dim>& run, std::vector<WrittenStep>& output_steps);
 
 extern template class CheckpointWriter<2>;
 extern template class CheckpointWriter<3>;

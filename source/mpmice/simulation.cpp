@@ -9,14 +9,16 @@
 #include "io/progress.hpp"
 #include "io/signals.hpp"
 #include "io/time_series.hpp"
-#include "mpmice/initial_state.hpp"
+#include "mpmice/run_state.hpp"
 #include "mpmice/state_output.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 namespace cfdmpm {
@@ -102,39 +104,80 @@ std::string agreedFailure(MPI_Comm comm, const std::string& failure)
   return first == ranks ? std::string() : broadcastText(comm, first, failure);
 }
 
+// The work of one particle in units of one cell's, for the weights of a rebalance
+// (domain.rebalance_interval), from the per-phase costs measured in doc/scaling.md ("Weights"):
+// with moving fluids a cell carries the whole fluid step and a particle its share of phases 1, 2
+// and 9; in a dry scene a cell carries only its node's share of the grid update.
+constexpr double kParticleWorkWithFluids = 0.1;
+constexpr double kParticleWorkDry = 2.0;
+// A new decomposition is taken only when it lowers the estimated imbalance by more than this (a
+// share of the mean load): moving costs about as much as a few steps (doc/scaling.md).
+constexpr double kRebalanceGain = 0.02;
+
+/// What redoing the decomposition found: the estimated imbalance (loadImbalance) of the division
+/// before and after, and the patches that changed rank (0: the run kept its division).
+struct RebalanceReport {
+  double imbalance_before = 0;
+  double imbalance_after = 0;
+  int patches_moved = 0;
+};
+
 template <int Dim>
 RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP<const Teuchos::Comm<int>>& comm)
 {
   const bool root = comm->getRank() == 0;
   const MPI_Comm mpi = rawMpiComm(comm);
 
-  // 1. Grid, decomposition of its patches with METIS, and this rank's share.
+  // 1. Grid and the decomposition of its patches with METIS by their cells. A restart on as many
+  //    ranks continues on the checkpoint's decomposition (a rebalance may have changed it); on
+  //    another number it starts from cells and, with rebalancing on, is redone with the particles
+  //    before its first step.
   const Grid<Dim> grid(scene.domain);
-  const Decomposition decomposition = partitionPatches(grid, comm->getSize());
-  const auto layout = std::make_shared<const Layout<Dim>>(grid, decomposition, scene.domain.ghost_width, comm);
+  const int ranks = comm->getSize();
+  const bool restarting = !options.restart_checkpoint.empty();
+  Decomposition decomposition;
+  bool rebalance_first = false;
+  if (restarting) {
+    const CheckpointHeader header = readCheckpointHeader(mpi, options.restart_checkpoint);
+    if (header.ranks == ranks) {
+      if (int(header.decomposition.size()) != grid.patchCount() ||
+          std::any_of(header.decomposition.begin(), header.decomposition.end(), [&](int r) { return r < 0 || r >= ranks; }))
+        throw InputError("checkpoint '" + header.path + "': its attribute decomposition is not one rank of " +
+                         std::to_string(ranks) + " for each of the grid's " + std::to_string(grid.patchCount()) +
+                         " patches");
+      decomposition.ranks = ranks;
+      decomposition.patch_owner = header.decomposition;
+    } else {
+      decomposition = partitionPatches(grid, ranks);
+      rebalance_first = scene.domain.rebalance_interval > 0;
+    }
+  } else {
+    decomposition = partitionPatches(grid, ranks);
+  }
   if (root)
     std::cout << "cfdmpm: " << (scene.title.empty() ? scene.path : scene.title) << "\n"
               << "  grid " << grid.cells()[0] << " x " << grid.cells()[1]
               << (Dim == 3 ? " x " + std::to_string(grid.cells()[2]) : std::string()) << " cells, "
-              << grid.patchCount() << " patches on " << comm->getSize() << " rank(s)\n";
+              << grid.patchCount() << " patches on " << ranks << " rank(s)\n";
 
   // 2. The initial state from the scene's regions and the materials' equations of state, and the
   //    coupled step with the material sets the scene has (their settings are checked here, before
   //    any output): fluids move unless ice.enabled is false (then they are an inert background, a
   //    dry scene for the particles alone); solids are particles.
-  CellState<Dim> state(layout, int(scene.materials.size()));
-  setInitialState(scene, densityFunctions(scene), state);
-  MpmIceStep<Dim> stepper(scene, layout, state);
+  //    A rebalance replaces all three (layout, state, step) with new ones: `run_state` is the
+  //    current set.
+  RunState<Dim> run_state = buildRunState(scene, grid, decomposition, comm);
   CoupledStepReport step_report;
-  const bool moves = stepper.fluidsMove() || stepper.hasParticles();
+  const bool moves = run_state.step->fluidsMove() || run_state.step->hasParticles();
+  const bool fluids_move = run_state.step->fluidsMove(), has_particles = run_state.step->hasParticles();
   std::vector<std::string> physics_columns;
-  if (stepper.fluidsMove()) {
+  if (fluids_move) {
     physics_columns = {"outer_iterations", "pressure_iterations", "outer_residual", "max_outflux_fraction"};
     // With particles, the solids' columns are theirs (exact masses), not the cells'.
-    for (const std::string& c : conservedColumns<Dim>(scene, stepper.hasParticles())) physics_columns.push_back(c);
+    for (const std::string& c : conservedColumns<Dim>(scene, has_particles)) physics_columns.push_back(c);
     physics_columns.insert(physics_columns.end(), {"equilibration_failures", "equilibration_jump", "exchange_failures", "pressure_converged"});
   }
-  if (stepper.hasParticles()) {
+  if (has_particles) {
     physics_columns.push_back("particles");
     for (const auto& m : scene.materials)
       if (m.kind == "solid") physics_columns.push_back("mass_" + m.name);
@@ -143,17 +186,17 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
   }
   auto physicsRow = [&] {
     std::vector<CsvValue> row;
-    if (stepper.fluidsMove()) {
+    if (fluids_move) {
       const IceStepReport& r = step_report.ice;
       row = {r.outer_iterations, r.linear_iterations, r.outer_residual, r.max_outflux_fraction};
-      const std::vector<double> sums = conservedQuantities(state);
-      for (int m = 0; m < state.materials; ++m)
-        if (!stepper.hasParticles() || scene.materials[m].kind == "fluid")
+      const std::vector<double> sums = conservedQuantities(*run_state.cells);
+      for (int m = 0; m < run_state.cells->materials; ++m)
+        if (!has_particles || scene.materials[m].kind == "fluid")
           for (int k = 0; k < Dim + 2; ++k) row.emplace_back(sums[m * (Dim + 2) + k]);
       row.insert(row.end(), {CsvValue(r.equilibration_failures), CsvValue(r.equilibration_jump), CsvValue(r.exchange_failures),
                              CsvValue(r.converged ? 1 : 0)});
     }
-    if (const mpm::MpmSolver<Dim>* particles = stepper.particles()) {
+    if (const mpm::MpmSolver<Dim>* particles = run_state.step->particles()) {
       row.emplace_back(particles->particleCount());
       for (double m : particles->materialMasses()) row.emplace_back(m);
       const auto p = particles->momentum();
@@ -168,32 +211,41 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
   //    state and the run's clock from the checkpoint; what the first run wrote after it is removed,
   //    the time series and the CSV continue from it.
   StateOutput<Dim>::checkFields(scene);
-  const bool restarting = !options.restart_checkpoint.empty();
   const std::string run_name =
       options.run_name.empty() ? std::filesystem::path(scene.path).stem().string() : options.run_name;
   RunClock clock;
   std::vector<WrittenStep> written_before;
   if (restarting) {
-    clock = readCheckpoint(options.restart_checkpoint, layout, state, stepper, written_before);
+    clock = readCheckpoint(options.restart_checkpoint, run_state, written_before);
   } else {
     prepareOutputDirectory(mpi, scene.output.directory, options.overwrite || scene.output.overwrite);
   }
-  StateOutput<Dim> output(scene, *layout, run_name);
+  StateOutput<Dim> output(scene, *run_state.layout, run_name);
   std::vector<std::string> columns{"step", "time", "dt", "dt_limiter", "retries"};
   if (moves)
     columns.insert(columns.end(), physics_columns.begin(), physics_columns.end());
   else
     for (const std::string& c : conservedColumns<Dim>(scene)) columns.push_back(c);
+  const int rebalance_interval = scene.domain.rebalance_interval;
+  if (moves && rebalance_interval > 0) columns.insert(columns.end(), {"imbalance_before", "imbalance_after", "patches_moved"});
   const std::string csv_path = scene.output.directory + "/" + run_name + ".csv";
   const auto diagnostics = restarting ? std::make_unique<CsvTimeSeries>(mpi, csv_path, columns, clock.step)
                                       : std::make_unique<CsvTimeSeries>(mpi, csv_path, columns);
   if (restarting) prepareRestartDirectory(mpi, scene.output.directory, run_name, clock.step);
+  // The rebalance made before the step a row reports, if any.
+  std::optional<RebalanceReport> rebalanced;
   auto report = [&](long long step, double time, double dt, const std::string& limiter, int retries) {
     std::vector<CsvValue> row{step, time, dt, limiter, retries};
     if (moves) {
       for (CsvValue& v : physicsRow()) row.push_back(v);
     } else {
-      for (double q : conservedQuantities(state)) row.emplace_back(q);
+      for (double q : conservedQuantities(*run_state.cells)) row.emplace_back(q);
+    }
+    if (moves && rebalance_interval > 0) {
+      if (rebalanced)
+        row.insert(row.end(), {rebalanced->imbalance_before, rebalanced->imbalance_after, rebalanced->patches_moved});
+      else
+        row.insert(row.end(), {"", "", ""});
     }
     diagnostics->append(row);
   };
@@ -203,9 +255,9 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
   summary.output_directory = scene.output.directory;
   summary.diagnostics = csv_path;
   auto writeOutput = [&](long long step, double time) {
-    if (!stepper.particles()) return output.write(step, time, state);
-    const mpm::ParticleOutput out = stepper.particles()->output();
-    return output.write(step, time, state, &out);
+    if (!run_state.step->particles()) return output.write(step, time, *run_state.cells);
+    const mpm::ParticleOutput out = run_state.step->particles()->output();
+    return output.write(step, time, *run_state.cells, &out);
   };
   summary.time_series = output.seriesPath();
   if (restarting) {
@@ -229,11 +281,11 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
   const double checkpoint_wall = scene.output.checkpoint_wall_interval;
   std::unique_ptr<CheckpointWriter<Dim>> checkpoints;
   if (checkpoint_interval > 0 || checkpoint_wall > 0)
-    checkpoints = std::make_unique<CheckpointWriter<Dim>>(scene, *layout, run_name, scene.output.directory);
+    checkpoints = std::make_unique<CheckpointWriter<Dim>>(scene, *run_state.layout, run_name, scene.output.directory);
   auto last_checkpoint_wall = std::chrono::steady_clock::now();
   long long last_checkpoint_step = restarting ? clock.step : -1;
   auto writeCheckpoint = [&] {
-    const std::string path = checkpoints->write(clock, state, stepper, output.writtenSteps());
+    const std::string path = checkpoints->write(clock, *run_state.cells, *run_state.step, output.writtenSteps());
     last_checkpoint_step = clock.step;
     last_checkpoint_wall = std::chrono::steady_clock::now();
     if (root) std::cout << "  checkpoint: " << path << "\n";
@@ -276,15 +328,15 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
     std::ostringstream text;
     text << "the pressure's outer iteration stopped at residual " << step_report.ice.outer_residual << " after "
          << step_report.ice.outer_iterations << " iterations (ice.outer_tolerance "
-         << stepper.fluids()->settings().outer_tolerance << ", ice.max_outer_iterations "
-         << stepper.fluids()->settings().max_outer_iterations << ")";
+         << run_state.step->fluids()->settings().outer_tolerance << ", ice.max_outer_iterations "
+         << run_state.step->fluids()->settings().max_outer_iterations << ")";
     return text.str();
   };
   // One attempt at the step; the failure, the same text on every rank, or empty.
   auto attempt = [&](double dt) {
     std::string failure;
     try {
-      step_report = stepper.step(state, dt);
+      step_report = run_state.step->step(*run_state.cells, dt);
     } catch (const StepFailure& e) {
       failure = e.what();
     }
@@ -297,7 +349,7 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
                                  ? writeOutput(step, t)
                                  : scene.output.directory + "/" + written.back().file;
     if (!checkpoints)
-      checkpoints = std::make_unique<CheckpointWriter<Dim>>(scene, *layout, run_name, scene.output.directory);
+      checkpoints = std::make_unique<CheckpointWriter<Dim>>(scene, *run_state.layout, run_name, scene.output.directory);
     if (last_checkpoint_step != step) writeCheckpoint();
     std::ostringstream message;
     message << "step " << step + 1 << " from t = " << showNumber(t) << " s failed";
@@ -313,8 +365,52 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
     throw StepFailure(message.str());
   };
 
+  // Every domain.rebalance_interval steps, the patches are divided again with METIS, each weighed by
+  // its cells and particles (patchWork); the run moves to the new division (redistribute: the way
+  // a restart builds a run, with the state of this one) when it is better balanced by more than
+  // kRebalanceGain. Every rank computes the same weights and the same division.
+  const double particle_work = fluids_move ? kParticleWorkWithFluids : kParticleWorkDry;
+  int rebalance_messages = 0;
+  auto rebalance = [&] {
+    RebalanceReport result;
+    std::vector<long long> particles;
+    if (const mpm::MpmSolver<Dim>* solids = run_state.step->particles()) particles = solids->particlesPerPatch();
+    const std::vector<double> work = patchWork(grid, particles, particle_work);
+    const Decomposition& current = run_state.layout->decomposition();
+    result.imbalance_before = result.imbalance_after = loadImbalance(rankLoads(current, work));
+    Decomposition balanced;
+    try {
+      balanced = closestNumbering(partitionPatches(grid, ranks, work), current, work);
+    } catch (const InputError&) {
+      return result;  // METIS left a rank without patches: stay
+    }
+    const double imbalance = loadImbalance(rankLoads(balanced, work));
+    if (!(imbalance < result.imbalance_before - kRebalanceGain)) return result;
+    for (int p = 0; p < grid.patchCount(); ++p) result.patches_moved += balanced.patch_owner[p] != current.patch_owner[p];
+    result.imbalance_after = imbalance;
+    run_state = redistribute(scene, run_state, balanced);
+    output.moveTo(*run_state.layout);
+    if (checkpoints)
+      checkpoints = std::make_unique<CheckpointWriter<Dim>>(scene, *run_state.layout, run_name, scene.output.directory);
+    if (root && ++rebalance_messages <= 10) {
+      std::ostringstream line;
+      line.precision(3);
+      line << "  step " << step << ": patches divided again by their cells and particles, imbalance "
+           << result.imbalance_before << " -> " << result.imbalance_after << ", " << result.patches_moved
+           << " of " << grid.patchCount() << " patches moved"
+           << (rebalance_messages == 10 ? " (further rebalances in the CSV only)" : "") << "\n";
+      std::cout << line.str();
+    }
+    return result;
+  };
+
   while (t < end - eps && (scene.time.max_steps < 0 || step < scene.time.max_steps)) {
-    TimeStepLimit limit = stepper.stableTimeStep(state, clock.dt_previous);
+    rebalanced.reset();
+    if (rebalance_interval > 0 && (step % rebalance_interval == 0 || rebalance_first)) {
+      rebalanced = rebalance();
+      rebalance_first = false;
+    }
+    TimeStepLimit limit = run_state.step->stableTimeStep(*run_state.cells, clock.dt_previous);
     if (step == 0 && scene.time.dt_initial < limit.dt) limit = {scene.time.dt_initial, "dt_initial"};
     clock.dt_previous = limit.dt;
     double dt = limit.dt;
@@ -327,12 +423,12 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
       dt = 0.5 * (next_output - t);
       limit.limiter += "+output";
     }
-    stepper.saveState(state);
+    run_state.step->saveState(*run_state.cells);
     int retries = 0;
     double unconverged_residual = INFINITY;  // of the previous attempt, when its outer iteration stopped short
     for (;;) {
       std::string failure = attempt(dt);
-      const bool unconverged = failure.empty() && stepper.fluidsMove() && !step_report.ice.converged;
+      const bool unconverged = failure.empty() && fluids_move && !step_report.ice.converged;
       if (unconverged) failure = outerIterationFailure();
       const bool test_undo = failure.empty() && retries == 0 && step + 1 == test_undo_step;
       if (test_undo) failure = "undone by CFDMPM_TEST_UNDO_STEP (a test)";
@@ -356,7 +452,7 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
                     << (clock.unconverged_warnings == 10 ? " (further warnings suppressed)" : "") << "\n";
         break;
       }
-      stepper.restoreState(state);
+      run_state.step->restoreState(*run_state.cells);
       if (exhausted) giveUp(failure, retries, dt);
       ++retries;
       if (root)

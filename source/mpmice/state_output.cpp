@@ -21,7 +21,7 @@ void StateOutput<Dim>::checkFields(const Scene& scene)
 
 template <int Dim>
 StateOutput<Dim>::StateOutput(const Scene& scene, const Layout<Dim>& layout, const std::string& run_name)
-    : fields_(scene.output.fields), directory_(scene.output.directory)
+    : fields_(scene.output.fields), directory_(scene.output.directory), run_name_(run_name)
 {
   for (const auto& m : scene.materials) material_names_.push_back(m.name);
   const MPI_Comm comm = rawMpiComm(layout.comm());
@@ -29,6 +29,14 @@ StateOutput<Dim>::StateOutput(const Scene& scene, const Layout<Dim>& layout, con
   const OutputLayout nodes = outputLayout(layout.grid(), Location::Node, layout.ownedNodeBoxes());
   hdf5_ = std::make_unique<Hdf5Writer>(comm, directory_, run_name, cells, nodes);
   xdmf_ = std::make_unique<XdmfWriter>(comm, directory_, run_name, cells, nodes);
+}
+
+template <int Dim>
+void StateOutput<Dim>::moveTo(const Layout<Dim>& layout)
+{
+  hdf5_ = std::make_unique<Hdf5Writer>(rawMpiComm(layout.comm()), directory_, run_name_,
+                                       outputLayout(layout.grid(), Location::Cell, layout.ownedCellBoxes()),
+                                       outputLayout(layout.grid(), Location::Node, layout.ownedNodeBoxes()));
 }
 
 template <int Dim>

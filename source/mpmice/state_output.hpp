@@ -45,6 +45,10 @@ class StateOutput {
 
   std::string seriesPath() const { return xdmf_->seriesPath(); }
 
+  /// Writes from here on with the owned cells and nodes of `layout`, a new decomposition of the same
+  /// grid (a rebalance); the time series goes on. Collective.
+  void moveTo(const Layout<Dim>& layout);
+
   /// The steps written so far (for a checkpoint), and after a restart the steps written before it
   /// (the time series is rewritten to list exactly those).
   const std::vector<WrittenStep>& writtenSteps() const { return xdmf_->steps(); }
@@ -56,6 +60,7 @@ class StateOutput {
   std::vector<std::string> material_names_;
   std::vector<std::string> fields_;
   std::string directory_;
+  std::string run_name_;
   std::unique_ptr<Hdf5Writer> hdf5_;
   std::unique_ptr<XdmfWriter> xdmf_;
   std::vector<double> buffer_;

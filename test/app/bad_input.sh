@@ -106,6 +106,10 @@ expect negative_checkpoint_wall_interval "$(good | sed 's/interval: 0.01}/interv
   "cfdmpm.output.checkpoint_wall_interval" "-60" ">= 0 (s)"
 expect no_checkpoints_kept "$(good | sed 's/interval: 0.01}/interval: 0.01, checkpoints_kept: 0}/')" \
   "cfdmpm.output.checkpoints_kept" "'0'" ">= 1"
+expect negative_rebalance_interval "$(good | sed 's/gravity: \[0.0, -9.81\]}/gravity: [0.0, -9.81], rebalance_interval: -5}/')" \
+  "cfdmpm.domain.rebalance_interval" "-5" ">= 0"
+expect fractional_rebalance_interval "$(good | sed 's/gravity: \[0.0, -9.81\]}/gravity: [0.0, -9.81], rebalance_interval: 2.5}/')" \
+  "cfdmpm.domain.rebalance_interval" "2.5" "integer"
 expect missing_key "$(good | grep -v '  time:')" "time"
 # Values as written, not as read (40.0 used to be echoed as 40, 1e-400 as 0); a repeated key named
 # with its own line (it used to be 'already exists in list "ANONYMOUS"' at the next line).

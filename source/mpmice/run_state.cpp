@@ -1,0 +1,68 @@
+#include "mpmice/run_state.hpp"
+
+#include "mpmice/initial_state.hpp"
+
+#include <map>
+
+namespace cfdmpm {
+
+template <int Dim>
+RunState<Dim> buildRunState(const Scene& scene, const Grid<Dim>& grid, const Decomposition& decomposition,
+                            const Teuchos::RCP<const Teuchos::Comm<int>>& comm)
+{
+  RunState<Dim> run;
+  run.layout = std::make_shared<const Layout<Dim>>(grid, decomposition, scene.domain.ghost_width, comm);
+  run.cells = std::make_unique<CellState<Dim>>(run.layout, int(scene.materials.size()));
+  setInitialState(scene, densityFunctions(scene), *run.cells);
+  run.step = std::make_unique<MpmIceStep<Dim>>(scene, run.layout, *run.cells);
+  return run;
+}
+
+template <int Dim>
+void adoptState(const CellValues<Dim>& cells, const typename mpm::MpmSolver<Dim>::ParticleSnapshot& particles,
+                int count, RunState<Dim>& run)
+{
+  for (const auto& [name, field] : namedFields(*run.cells)) {
+    cells(name, *field);
+    field->exchangeHalo();
+  }
+  if (IceSolver<Dim>* fluids = run.step->fluids()) {
+    Field<Dim> reference(run.layout, Location::Cell, 1, "solid_reference_pressure");
+    cells(kSolidReferencePressureName, reference);
+    reference.exchangeHalo();
+    fluids->setSolidReferencePressure(reference);
+  }
+  if (mpm::MpmSolver<Dim>* solids = run.step->particles()) {
+    solids->restoreParticles(particles, count);
+    solids->relocateParticles();
+  }
+}
+
+template <int Dim>
+RunState<Dim> redistribute(const Scene& scene, RunState<Dim>& from, const Decomposition& decomposition)
+{
+  RunState<Dim> to = buildRunState(scene, from.layout->grid(), decomposition, from.layout->comm());
+  std::map<std::string, const Field<Dim>*> fields;
+  for (const auto& [name, field] : namedFields(std::as_const(*from.cells))) fields[name] = field;
+  if (const IceSolver<Dim>* fluids = from.step->fluids()) fields[kSolidReferencePressureName] = &fluids->solidReferencePressure();
+  typename mpm::MpmSolver<Dim>::ParticleSnapshot particles;
+  int count = 0;
+  if (const mpm::MpmSolver<Dim>* solids = from.step->particles()) {
+    solids->saveParticles(particles);
+    count = solids->particles().count;
+  }
+  adoptState<Dim>([&](const std::string& name, Field<Dim>& field) { field.importOwned(*fields.at(name)); }, particles,
+                  count, to);
+  return to;
+}
+
+template RunState<2> buildRunState(const Scene&, const Grid<2>&, const Decomposition&,
+                                   const Teuchos::RCP<const Teuchos::Comm<int>>&);
+template RunState<3> buildRunState(const Scene&, const Grid<3>&, const Decomposition&,
+                                   const Teuchos::RCP<const Teuchos::Comm<int>>&);
+template void adoptState(const CellValues<2>&, const mpm::MpmSolver<2>::ParticleSnapshot&, int, RunState<2>&);
+template void adoptState(const CellValues<3>&, const mpm::MpmSolver<3>::ParticleSnapshot&, int, RunState<3>&);
+template RunState<2> redistribute(const Scene&, RunState<2>&, const Decomposition&);
+template RunState<3> redistribute(const Scene&, RunState<3>&, const Decomposition&);
+
+}  // namespace cfdmpm

@@ -12,6 +12,8 @@
 #include "mpmice/run_state.hpp"
 #include "mpmice/state_output.hpp"
 
+#include <Teuchos_TimeMonitor.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -105,13 +107,19 @@ std::string agreedFailure(MPI_Comm comm, const std::string& failure)
 }
 
 // The work of one particle in units of one cell's, for the weights of a rebalance
-// (domain.rebalance_interval), from the per-phase costs measured in doc/scaling.md ("Weights"):
-// with moving fluids a cell carries the whole fluid step and a particle its share of phases 1, 2
-// and 9; in a dry scene a cell carries only its node's share of the grid update.
-constexpr double kParticleWorkWithFluids = 0.1;
-constexpr double kParticleWorkDry = 2.0;
+// (domain.rebalance_interval), from the per-phase costs measured on one core (doc/scaling.md,
+// "Weights"; bench/scaling.sh): with moving fluids a cell carries the whole fluid step and a
+// particle its share of phases 1, 2, 9 and 12 and of the sums between steps (the slide: 0.14 in
+// 2-D, 0.27 in 3-D); in a dry scene a cell carries only its nodes' share of the grid update (the
+// granular column: 11; not measured in 3-D, where the 2-D value is taken).
+double particleWork(int dimension, bool fluids_move)
+{
+  if (!fluids_move) return 11.0;
+  return dimension == 3 ? 0.27 : 0.14;
+}
 // A new decomposition is taken only when it lowers the estimated imbalance by more than this (a
-// share of the mean load): moving costs about as much as a few steps (doc/scaling.md).
+// share of the mean load): a move costs about as much as three steps (doc/scaling.md), which a gain
+// of 2 % pays back within 150 steps.
 constexpr double kRebalanceGain = 0.02;
 
 /// What redoing the decomposition found: the estimated imbalance (loadImbalance) of the division
@@ -369,9 +377,11 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
   // its cells and particles (patchWork); the run moves to the new division (redistribute: the way
   // a restart builds a run, with the state of this one) when it is better balanced by more than
   // kRebalanceGain. Every rank computes the same weights and the same division.
-  const double particle_work = fluids_move ? kParticleWorkWithFluids : kParticleWorkDry;
+  const double particle_work = particleWork(Dim, fluids_move);
   int rebalance_messages = 0;
+  const Teuchos::RCP<Teuchos::Time> rebalance_timer = Teuchos::TimeMonitor::getNewCounter("cfdmpm: rebalance");
   auto rebalance = [&] {
+    Teuchos::TimeMonitor timed(*rebalance_timer);
     RebalanceReport result;
     std::vector<long long> particles;
     if (const mpm::MpmSolver<Dim>* solids = run_state.step->particles()) particles = solids->particlesPerPatch();

@@ -82,3 +82,45 @@ TEST(Decomposition, TooFewPatchesNamesTheKey)
     EXPECT_NE(std::string(e.what()).find("domain.patch_cells"), std::string::npos);
   }
 }
+
+TEST(Decomposition, RenumberedDivisionKeepsWorkWhereItIs)
+{
+  // The same division with its parts numbered the other way round moves nothing once renumbered;
+  // a new division keeps each part on the rank that holds most of its work.
+  const Grid<2> grid({0, 0, 0}, {1, 1, 0}, {128, 128, 1}, {16, 16, 1});
+  const std::vector<double> w = cellWeights(grid);
+  const Decomposition current = partitionPatches(grid, 4);
+  Decomposition reversed = current;
+  for (int& owner : reversed.patch_owner) owner = 3 - owner;
+  EXPECT_EQ(closestNumbering(reversed, current, w).patch_owner, current.patch_owner);
+
+  std::vector<double> heavy = w;
+  for (int p = 0; p < grid.patchCount(); ++p)
+    if (grid.patchIndex(p)[0] < 2) heavy[p] *= 3;  // particles gathered at the left
+  const Decomposition balanced = closestNumbering(partitionPatches(grid, 4, heavy), current, heavy);
+  int moved = 0, moved_unnumbered = 0;
+  const Decomposition fresh = partitionPatches(grid, 4, heavy);
+  for (int p = 0; p < grid.patchCount(); ++p) {
+    moved += balanced.patch_owner[p] != current.patch_owner[p];
+    moved_unnumbered += fresh.patch_owner[p] != current.patch_owner[p];
+  }
+  EXPECT_LE(moved, moved_unnumbered);
+  EXPECT_LT(moved, grid.patchCount() / 2) << "a renumbered division should keep most patches in place";
+  // Renumbering changes no rank's load, only which rank carries it.
+  std::vector<double> a = rankLoads(balanced, heavy), b = rankLoads(fresh, heavy);
+  std::sort(a.begin(), a.end());
+  std::sort(b.begin(), b.end());
+  EXPECT_EQ(a, b);
+}
+
+TEST(Decomposition, ImbalanceAndWork)
+{
+  EXPECT_DOUBLE_EQ(loadImbalance({1.0, 1.0, 1.0}), 0.0);
+  EXPECT_DOUBLE_EQ(loadImbalance({3.0, 1.0}), 0.5);  // the heavier rank has 1.5 times the mean
+  // A patch's work: its cells plus particle_work per particle; the last patch in x is smaller.
+  const Grid<2> grid({0, 0, 0}, {1, 1, 0}, {24, 16, 1}, {16, 16, 1});
+  const std::vector<double> work = patchWork(grid, {10, 20}, 0.5);
+  EXPECT_DOUBLE_EQ(work[0], 256 + 5.0);
+  EXPECT_DOUBLE_EQ(work[1], 128 + 10.0);
+  EXPECT_EQ(patchWork(grid, {}, 0.5), cellWeights(grid));
+}

@@ -233,3 +233,21 @@ TEST(ParticleMigration, RepartitionSendsParticlesToTheirNewOwners)
   solver.step(kDt);
   EXPECT_EQ(solver.particleCount(), count);
 }
+
+TEST(ParticleMigration, ParticlesPerPatchAreTheSameOnEveryRankCount)
+{
+  // The particles of every patch, summed over the ranks: the weights of a rebalance. They must add
+  // up to the particle count and not depend on the decomposition (here: on 1, 2 or 3 ranks against
+  // the count from the seeding lattice of each patch on rank 0 alone).
+  const Scene scene = crossingScene();
+  MpmSolver<2> solver(scene, scenes::layoutFor<2>(scene, world()), MpmOptions{});
+  const std::vector<long long> per_patch = solver.particlesPerPatch();
+  long long sum = 0;
+  for (long long n : per_patch) sum += n;
+  EXPECT_EQ(sum, solver.particleCount());
+  const auto alone = world()->split(world()->getRank() == 0 ? 0 : 1, world()->getRank());
+  if (world()->getRank() == 0) {
+    MpmSolver<2> one(scene, scenes::layoutFor<2>(scene, alone), MpmOptions{});
+    EXPECT_EQ(one.particlesPerPatch(), per_patch);
+  }
+}

@@ -32,6 +32,7 @@ struct RankFigures {
 
 struct Summary {
   RankFigures most, mean;
+  std::vector<RankFigures> ranks;
 };
 
 /// Particles in every cell of the 2-D scene's grid, seeded as MpmSolver seeds them.
@@ -99,6 +100,7 @@ Summary measure(const Grid<Dim>& grid, const Decomposition& decomposition, const
     figures[r].neighbours = double(neighbours.size());
   }
   Summary s;
+  s.ranks = figures;
   for (const RankFigures& f : figures) {
     s.most.cells = std::max(s.most.cells, f.cells), s.mean.cells += f.cells / ranks;
     s.most.particles = std::max(s.most.particles, f.particles), s.mean.particles += f.particles / ranks;
@@ -130,23 +132,29 @@ void run(const Scene& scene, const std::vector<double>& particles_2d, double par
         for (long long i = b.lower[0]; i < b.upper[0]; ++i) column += particles_2d[std::size_t(i + nx * j)];
       particles[p] = Dim == 3 ? column * double(b.extent(2)) * particles_per_cell_z : column;
     }
-    const std::vector<double> work = patchWork(grid, std::vector<long long>(particles.begin(), particles.end()), particle_work);
+    const PatchWork work = patchWork(grid, std::vector<long long>(particles.begin(), particles.end()), particle_work);
     for (int weighted = 0; weighted < 2; ++weighted) {
       const Decomposition decomposition = weighted ? partitionPatches(grid, ranks, work) : partitionPatches(grid, ranks);
       const Summary s = measure(grid, decomposition, particles, particle_work, scene.domain.ghost_width);
       std::printf("%5d ranks, patches %3lld^%d (%6d): by %-15s cells %9.0f (%9.0f)  particles %9.0f (%9.0f)  "
-                  "work imbalance %5.3f  ghosts %7.0f (%7.0f)  neighbours %3.0f (%4.1f)\n",
+                  "imbalance %5.3f  ghosts %7.0f (%7.0f)  neighbours %3.0f (%4.1f)\n",
                   ranks, patch, Dim, grid.patchCount(), weighted ? "cells+particles" : "cells", s.most.cells,
-                  s.mean.cells, s.most.particles, s.mean.particles, s.most.work / s.mean.work - 1, s.most.ghosts,
+                  s.mean.cells, s.most.particles, s.mean.particles, loadImbalance(decomposition, work), s.most.ghosts,
                   s.mean.ghosts, s.most.neighbours, s.mean.neighbours);
-      if (json)
+      if (json) {
         std::fprintf(json,
                      "%s  {\"dimension\": %d, \"ranks\": %d, \"patch\": %lld, \"weights\": \"%s\", \"cells\": [%.0f, %.6g], "
                      "\"particles\": [%.0f, %.6g], \"work\": [%.6g, %.6g], \"ghosts\": [%.0f, %.6g], "
-                     "\"neighbours\": [%.0f, %.6g]}",
+                     "\"neighbours\": [%.0f, %.6g], \"per_rank\": [",
                      first ? "" : ",\n", Dim, ranks, patch, weighted ? "cells+particles" : "cells", s.most.cells,
                      s.mean.cells, s.most.particles, s.mean.particles, s.most.work, s.mean.work, s.most.ghosts,
                      s.mean.ghosts, s.most.neighbours, s.mean.neighbours);
+        // Every rank's cells, particles, ghosts and neighbours, for per-phase maxima.
+        for (std::size_t r = 0; r < s.ranks.size(); ++r)
+          std::fprintf(json, "%s[%.0f, %.0f, %.0f, %.0f]", r ? ", " : "", s.ranks[r].cells, s.ranks[r].particles,
+                       s.ranks[r].ghosts, s.ranks[r].neighbours);
+        std::fprintf(json, "]}");
+      }
       first = false;
     }
   }

@@ -10,7 +10,8 @@ The model, per time step of the slowest rank on P ranks (doc/scaling.md, "The mo
                              + m_phase(P) alpha + B_phase(P) / beta          halo messages
                              + R_phase(P) t_reduce(P)                        reductions
 
-C and N are the cells and particles of the heaviest rank (bench_halos, from METIS on P ranks);
+C and N are the cells and particles of a rank (bench_halos, from METIS on P ranks), the phase's
+slowest rank counting (a phase ends with an exchange that waits for it);
 a and b the measured seconds per cell and per particle of the phase on one core (two runs that
 differ only in particles per cell split them); m and B the messages and bytes of the phase, from
 the counts measured on 8 ranks, scaled by the neighbours and ghost cells of the heaviest rank on
@@ -172,6 +173,27 @@ def exchange_seconds(ranks, dimension, exchanges, neighbours, byte_count):
     return exchanges * (latency + max(0.0, neighbours - 1) * a["message_overhead_s"]) + byte_count * per_byte
 
 
+def estimate(h, dim, costs, exchanges, per_ghost, reductions):
+    """Compute, exchange and reduction seconds per step of the heaviest rank of halo record h, and
+    each phase's seconds."""
+    a = ASSUMED
+    ranks = h["ranks"]
+    growth = 1 + a["iteration_growth"] * math.log2(ranks / 8)
+    t_reduce = a["reduce_stage_s"] * math.log2(ranks)
+    phase_time = {}
+    compute = messages = reduce_time = 0
+    for p, (ca, cb) in costs.items():
+        g = growth if p == "mpmice: 3-6 fluid pressure" else 1.0
+        # The phase ends with an exchange that waits for its slowest rank.
+        c = a["node_slowdown"] * max(ca * cells + cb * particles for cells, particles, _, _ in h["per_rank"])
+        m = exchange_seconds(ranks, dim, g * exchanges.get(p, 0), h["neighbours"][0],
+                             g * per_ghost.get(p, 0) * h["ghosts"][0])
+        r = g * reductions.get(p, 0) * t_reduce
+        phase_time[p] = c + m + r
+        compute, messages, reduce_time = compute + c, messages + m, reduce_time + r
+    return compute, messages, reduce_time, phase_time
+
+
 def steps_to_end(out, name, end_time):
     """Steps of a whole run: the end time over the Δt of the run's last steps."""
     dt = csv_column(out, name, "dt")[-3:]
@@ -246,21 +268,10 @@ def model(out):
               "reductions ms | step ms | limiting phase (share) | efficiency |")
         print("|---|---|---|---|---|---|---|---|---|---|---|---|")
         for h in halos:
-            ranks = h["ranks"]
-            if ranks < 64:
+            if h["ranks"] < 64:
                 continue
-            growth = 1 + a["iteration_growth"] * math.log2(ranks / 8)
-            t_reduce = a["reduce_stage_s"] * math.log2(ranks)
-            phase_time = {}
-            compute = messages = reduce_time = 0
-            for p, (ca, cb) in costs.items():
-                g = growth if p == "mpmice: 3-6 fluid pressure" else 1.0
-                c = a["node_slowdown"] * (ca * h["cells"][0] + cb * h["particles"][0])
-                m = exchange_seconds(ranks, dim, g * exchanges.get(p, 0), h["neighbours"][0],
-                                     g * per_ghost.get(p, 0) * h["ghosts"][0])
-                r = g * reductions.get(p, 0) * t_reduce
-                phase_time[p] = c + m + r
-                compute, messages, reduce_time = compute + c, messages + m, reduce_time + r
+            ranks = h["ranks"]
+            compute, messages, reduce_time, phase_time = estimate(h, dim, costs, exchanges, per_ghost, reductions)
             step = compute + messages + reduce_time
             serial = sum(ca * h["cells"][1] * ranks + cb * h["particles"][1] * ranks for ca, cb in costs.values())
             limiting = max(phase_time, key=phase_time.get)
@@ -268,6 +279,19 @@ def model(out):
                 ranks, h["weights"], h["cells"][0], h["particles"][0], h["ghosts"][0], h["neighbours"][0],
                 1e3 * compute, 1e3 * messages, 1e3 * reduce_time, 1e3 * step, limiting.replace("mpmice: ", ""),
                 100 * phase_time[limiting] / step, serial / (ranks * step)))
+        # How much the estimate on the most ranks depends on each assumption.
+        largest = [h for h in halos if h["weights"] == "cells+particles"][-1]
+        base = sum(estimate(largest, dim, costs, exchanges, per_ghost, reductions)[:3])
+        variants = []
+        for key, factor in (("iteration_growth", 0.0), ("iteration_growth", 2.0), ("latency_s", 2.0),
+                            ("message_overhead_s", 2.0), ("node_bandwidth_Bps", 0.5), ("reduce_stage_s", 2.0),
+                            ("node_slowdown", 1 / 1.5)):
+            saved = ASSUMED[key]
+            ASSUMED[key] = saved * factor
+            variants.append("%s x %g: %.1f ms" % (key, factor, 1e3 * sum(
+                estimate(largest, dim, costs, exchanges, per_ghost, reductions)[:3])))
+            ASSUMED[key] = saved
+        print("Sensitivity on %d ranks (%.1f ms): %s" % (largest["ranks"], 1e3 * base, "; ".join(variants)))
         print("(%.3g cells, %.3g particles; one core: %.2f s per step; 0.8 s of slide: %.3g steps)\n"
               % (h["cells"][1] * ranks, h["particles"][1] * ranks, serial, steps2d))
 

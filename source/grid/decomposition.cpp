@@ -13,24 +13,35 @@ namespace cfdmpm {
 
 namespace {
 
-// METIS wants integer vertex weights; scale so that the lightest patch weighs ~1000 units, which
-// keeps the rounding error of a weight below 0.1 %.
-std::vector<idx_t> integerWeights(const std::vector<double>& weight)
+// METIS wants integer vertex weights, interleaved per vertex for several constraints. Each
+// constraint is scaled so that its lightest nonzero patch weighs ~1000 units, which keeps the
+// rounding error of a weight below 0.1 %; idx_t is 32-bit, so each total stays below 2^30 / ncon.
+// The first constraint's weights are at least 1 (every patch has cells); the others may be 0.
+std::vector<idx_t> integerWeights(const std::vector<std::vector<double>>& constraints)
 {
-  const double smallest = *std::min_element(weight.begin(), weight.end());
-  const double total = std::accumulate(weight.begin(), weight.end(), 0.0);
-  // idx_t is 32-bit: keep the total below 2^30.
-  const double scale = std::min(1000.0 / smallest, double(1 << 30) / total);
-  std::vector<idx_t> w(weight.size());
-  for (std::size_t i = 0; i < weight.size(); ++i)
-    w[i] = std::max<idx_t>(1, idx_t(std::llround(weight[i] * scale)));
+  const std::size_t ncon = constraints.size(), n = constraints.front().size();
+  std::vector<idx_t> w(n * ncon);
+  for (std::size_t c = 0; c < ncon; ++c) {
+    const std::vector<double>& weight = constraints[c];
+    double smallest = INFINITY;
+    for (double x : weight)
+      if (x > 0) smallest = std::min(smallest, x);
+    const double total = std::accumulate(weight.begin(), weight.end(), 0.0);
+    const double scale = std::min(1000.0 / smallest, double(1 << 30) / double(ncon) / total);
+    for (std::size_t i = 0; i < n; ++i)
+      w[i * ncon + c] = std::max<idx_t>(c == 0 ? 1 : 0, idx_t(std::llround(weight[i] * scale)));
+  }
   return w;
 }
 
 }  // namespace
 
+namespace {
+
+/// METIS on the patch graph with one weight per patch and constraint, each constraint balanced on
+/// its own. The first constraint's weights are > 0, the others' >= 0 with a positive total.
 template <int Dim>
-Decomposition partitionPatches(const Grid<Dim>& grid, int ranks, const std::vector<double>& patch_weight)
+Decomposition partition(const Grid<Dim>& grid, int ranks, const std::vector<std::vector<double>>& constraints)
 {
   const int patches = grid.patchCount();
   if (ranks < 1) throw std::invalid_argument("partitionPatches: ranks must be >= 1");
@@ -38,16 +49,14 @@ Decomposition partitionPatches(const Grid<Dim>& grid, int ranks, const std::vect
     throw InputError("domain.patch_cells: the grid has " + std::to_string(patches) +
                      " patches for " + std::to_string(ranks) +
                      " ranks; every rank needs at least one patch: choose smaller patches or fewer ranks");
-
-  std::vector<double> weight = patch_weight;
-  if (weight.empty()) {
-    weight.resize(patches);
-    for (int p = 0; p < patches; ++p) weight[p] = double(grid.patchCells(p).count());
+  for (std::size_t c = 0; c < constraints.size(); ++c) {
+    if (int(constraints[c].size()) != patches)
+      throw std::invalid_argument("partitionPatches: one weight per patch is needed");
+    for (double w : constraints[c])
+      if (!(c == 0 ? w > 0 : w >= 0)) throw std::invalid_argument("partitionPatches: patch weights must be > 0");
+    if (!(std::accumulate(constraints[c].begin(), constraints[c].end(), 0.0) > 0))
+      throw std::invalid_argument("partitionPatches: a constraint without weight");
   }
-  if (int(weight.size()) != patches)
-    throw std::invalid_argument("partitionPatches: one weight per patch is needed");
-  for (double w : weight)
-    if (!(w > 0)) throw std::invalid_argument("partitionPatches: patch weights must be > 0");
 
   Decomposition result;
   result.ranks = ranks;
@@ -72,8 +81,8 @@ Decomposition partitionPatches(const Grid<Dim>& grid, int ranks, const std::vect
     xadj.push_back(idx_t(adjncy.size()));
   }
 
-  std::vector<idx_t> vwgt = integerWeights(weight);
-  idx_t nvtxs = patches, ncon = 1, nparts = ranks, objval = 0;
+  std::vector<idx_t> vwgt = integerWeights(constraints);
+  idx_t nvtxs = patches, ncon = idx_t(constraints.size()), nparts = ranks, objval = 0;
   std::vector<idx_t> part(patches, 0);
   idx_t options[METIS_NOPTIONS];
   METIS_SetDefaultOptions(options);
@@ -99,6 +108,30 @@ Decomposition partitionPatches(const Grid<Dim>& grid, int ranks, const std::vect
       throw InputError("domain.patch_cells: METIS left rank " + std::to_string(r) +
                        " without patches; choose smaller patches");
   return result;
+}
+
+}  // namespace
+
+template <int Dim>
+Decomposition partitionPatches(const Grid<Dim>& grid, int ranks, const std::vector<double>& patch_weight)
+{
+  if (!patch_weight.empty()) return partition(grid, ranks, {patch_weight});
+  std::vector<double> cells(grid.patchCount());
+  for (int p = 0; p < grid.patchCount(); ++p) cells[p] = double(grid.patchCells(p).count());
+  return partition(grid, ranks, {cells});
+}
+
+template <int Dim>
+Decomposition partitionPatches(const Grid<Dim>& grid, int ranks, const PatchWork& work)
+{
+  if (!(std::accumulate(work.particles.begin(), work.particles.end(), 0.0) > 0)) return partition(grid, ranks, {work.cells});
+  try {
+    return partition(grid, ranks, {work.cells, work.particles});
+  } catch (const InputError&) {
+    // With few patches per rank METIS may find no division that balances both and leave a rank
+    // without patches: then the total work is balanced.
+    return partition(grid, ranks, {work.total()});
+  }
 }
 
 std::vector<double> rankLoads(const Decomposition& decomposition, const std::vector<double>& patch_weight)
@@ -148,17 +181,35 @@ double loadImbalance(const std::vector<double>& load)
 }
 
 template <int Dim>
-std::vector<double> patchWork(const Grid<Dim>& grid, const std::vector<long long>& particles, double particle_work)
+PatchWork patchWork(const Grid<Dim>& grid, const std::vector<long long>& particles, double particle_work)
 {
-  std::vector<double> work(grid.patchCount());
-  for (int p = 0; p < grid.patchCount(); ++p)
-    work[p] = double(grid.patchCells(p).count()) + (particles.empty() ? 0.0 : particle_work * double(particles[p]));
+  PatchWork work;
+  work.cells.resize(grid.patchCount());
+  work.particles.assign(grid.patchCount(), 0.0);
+  for (int p = 0; p < grid.patchCount(); ++p) {
+    work.cells[p] = double(grid.patchCells(p).count());
+    if (!particles.empty()) work.particles[p] = particle_work * double(particles[p]);
+  }
   return work;
+}
+
+double loadImbalance(const Decomposition& decomposition, const PatchWork& work)
+{
+  const std::vector<double> cells = rankLoads(decomposition, work.cells);
+  const std::vector<double> particles = rankLoads(decomposition, work.particles);
+  const double ranks = double(decomposition.ranks);
+  const double balanced = (std::accumulate(cells.begin(), cells.end(), 0.0) +
+                           std::accumulate(particles.begin(), particles.end(), 0.0)) / ranks;
+  const double slowest = *std::max_element(cells.begin(), cells.end()) +
+                         *std::max_element(particles.begin(), particles.end());
+  return balanced > 0 ? slowest / balanced - 1.0 : 0.0;
 }
 
 template Decomposition partitionPatches<2>(const Grid<2>&, int, const std::vector<double>&);
 template Decomposition partitionPatches<3>(const Grid<3>&, int, const std::vector<double>&);
-template std::vector<double> patchWork(const Grid<2>&, const std::vector<long long>&, double);
-template std::vector<double> patchWork(const Grid<3>&, const std::vector<long long>&, double);
+template Decomposition partitionPatches<2>(const Grid<2>&, int, const PatchWork&);
+template Decomposition partitionPatches<3>(const Grid<3>&, int, const PatchWork&);
+template PatchWork patchWork(const Grid<2>&, const std::vector<long long>&, double);
+template PatchWork patchWork(const Grid<3>&, const std::vector<long long>&, double);
 
 }  // namespace cfdmpm

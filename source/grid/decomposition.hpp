@@ -44,9 +44,34 @@ Decomposition closestNumbering(const Decomposition& division, const Decompositio
 /// a balanced one would).
 double loadImbalance(const std::vector<double>& load);
 
-/// The work of every patch in units of one cell's: its cells, plus `particle_work` per particle
-/// (`particles` indexed by patch id; empty: no particles).
+/// The work of every patch in units of one cell's, in the two parts that different phases of a
+/// step do: the cells' (fluid phases, one per cell) and the particles' (particle phases,
+/// `particle_work` per particle). A phase ends with a halo exchange that waits for its slowest
+/// rank, so each part needs to be balanced on its own.
+struct PatchWork {
+  std::vector<double> cells;
+  std::vector<double> particles;
+
+  std::vector<double> total() const
+  {
+    std::vector<double> sum = cells;
+    for (std::size_t p = 0; p < sum.size(); ++p) sum[p] += particles[p];
+    return sum;
+  }
+};
+
+/// The work of the grid's patches with `particles` per patch (indexed by patch id; empty: none).
 template <int Dim>
-std::vector<double> patchWork(const Grid<Dim>& grid, const std::vector<long long>& particles, double particle_work);
+PatchWork patchWork(const Grid<Dim>& grid, const std::vector<long long>& particles, double particle_work);
+
+/// Partitions the patches with both parts of the work balanced, each on its own (METIS with two
+/// constraints; with no particles, by cells). Where METIS finds no such division that gives every
+/// rank a patch (few patches per rank), the total work is balanced. Deterministic like the other.
+template <int Dim>
+Decomposition partitionPatches(const Grid<Dim>& grid, int ranks, const PatchWork& work);
+
+/// The estimated imbalance of a step: the slowest rank's cell work plus the slowest rank's particle
+/// work (each phase waits for its own slowest rank), over the balanced work per rank, minus one.
+double loadImbalance(const Decomposition& decomposition, const PatchWork& work);
 
 }  // namespace cfdmpm

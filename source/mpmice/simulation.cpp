@@ -373,10 +373,11 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
     throw StepFailure(message.str());
   };
 
-  // Every domain.rebalance_interval steps, the patches are divided again with METIS, each weighed by
-  // its cells and particles (patchWork); the run moves to the new division (redistribute: the way
-  // a restart builds a run, with the state of this one) when it is better balanced by more than
-  // kRebalanceGain. Every rank computes the same weights and the same division.
+  // Every domain.rebalance_interval steps, the patches are divided again with METIS so that the
+  // cells' work and the particles' work (patchWork) are balanced each on its own, as the phases
+  // that do them wait for their own slowest rank; the run moves to the new division (redistribute:
+  // the way a restart builds a run, with the state of this one) when its estimated imbalance is
+  // lower by more than kRebalanceGain. Every rank computes the same weights and the same division.
   const double particle_work = particleWork(Dim, fluids_move);
   int rebalance_messages = 0;
   const Teuchos::RCP<Teuchos::Time> rebalance_timer = Teuchos::TimeMonitor::getNewCounter("cfdmpm: rebalance");
@@ -385,16 +386,16 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
     RebalanceReport result;
     std::vector<long long> particles;
     if (const mpm::MpmSolver<Dim>* solids = run_state.step->particles()) particles = solids->particlesPerPatch();
-    const std::vector<double> work = patchWork(grid, particles, particle_work);
+    const PatchWork work = patchWork(grid, particles, particle_work);
     const Decomposition& current = run_state.layout->decomposition();
-    result.imbalance_before = result.imbalance_after = loadImbalance(rankLoads(current, work));
+    result.imbalance_before = result.imbalance_after = loadImbalance(current, work);
     Decomposition balanced;
     try {
-      balanced = closestNumbering(partitionPatches(grid, ranks, work), current, work);
+      balanced = closestNumbering(partitionPatches(grid, ranks, work), current, work.total());
     } catch (const InputError&) {
       return result;  // METIS left a rank without patches: stay
     }
-    const double imbalance = loadImbalance(rankLoads(balanced, work));
+    const double imbalance = loadImbalance(balanced, work);
     if (!(imbalance < result.imbalance_before - kRebalanceGain)) return result;
     for (int p = 0; p < grid.patchCount(); ++p) result.patches_moved += balanced.patch_owner[p] != current.patch_owner[p];
     result.imbalance_after = imbalance;

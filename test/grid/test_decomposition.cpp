@@ -117,10 +117,36 @@ TEST(Decomposition, ImbalanceAndWork)
 {
   EXPECT_DOUBLE_EQ(loadImbalance({1.0, 1.0, 1.0}), 0.0);
   EXPECT_DOUBLE_EQ(loadImbalance({3.0, 1.0}), 0.5);  // the heavier rank has 1.5 times the mean
-  // A patch's work: its cells plus particle_work per particle; the last patch in x is smaller.
+  // A patch's work: its cells, and particle_work per particle; the last patch in x is smaller.
   const Grid<2> grid({0, 0, 0}, {1, 1, 0}, {24, 16, 1}, {16, 16, 1});
-  const std::vector<double> work = patchWork(grid, {10, 20}, 0.5);
-  EXPECT_DOUBLE_EQ(work[0], 256 + 5.0);
-  EXPECT_DOUBLE_EQ(work[1], 128 + 10.0);
-  EXPECT_EQ(patchWork(grid, {}, 0.5), cellWeights(grid));
+  const PatchWork work = patchWork(grid, {10, 20}, 0.5);
+  EXPECT_EQ(work.cells, cellWeights(grid));
+  EXPECT_EQ(work.particles, (std::vector<double>{5.0, 10.0}));
+  EXPECT_EQ(work.total(), (std::vector<double>{261.0, 138.0}));
+  EXPECT_EQ(patchWork(grid, {}, 0.5).particles, (std::vector<double>{0.0, 0.0}));
+  // Each phase waits for its slowest rank: rank 0 with the most cells and rank 1 with the most
+  // particles make a step of 256 + 10 against a balanced (384 + 15) / 2.
+  Decomposition two;
+  two.ranks = 2;
+  two.patch_owner = {0, 1};
+  EXPECT_DOUBLE_EQ(loadImbalance(two, work), (256.0 + 10.0) / ((384.0 + 15.0) / 2) - 1);
+}
+
+TEST(Decomposition, CellsAndParticlesAreBalancedEachOnItsOwn)
+{
+  // Particles in the left eighth of a grid, 16 per cell at 0.14 cells each: by total work alone a
+  // rank gets the particles' patches and few cells, the others many cells; with two constraints
+  // every rank gets about as many cells and as many particles as the others.
+  const Grid<2> grid({0, 0, 0}, {1, 1, 0}, {256, 128, 1}, {8, 8, 1});
+  std::vector<long long> particles(grid.patchCount(), 0);
+  for (int p = 0; p < grid.patchCount(); ++p)
+    if (grid.patchIndex(p)[0] < 4) particles[p] = 16 * 64;
+  const PatchWork work = patchWork(grid, particles, 0.14);
+  for (int ranks : {2, 4, 16}) {
+    const Decomposition both = partitionPatches(grid, ranks, work);
+    const Decomposition total = partitionPatches(grid, ranks, work.total());
+    EXPECT_LT(loadImbalance(rankLoads(both, work.cells)), 0.10) << ranks << " ranks";
+    EXPECT_LT(loadImbalance(rankLoads(both, work.particles)), 0.10) << ranks << " ranks";
+    EXPECT_LT(loadImbalance(both, work), loadImbalance(total, work)) << ranks << " ranks";
+  }
 }

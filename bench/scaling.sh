@@ -40,9 +40,9 @@ run slide2d_20mm_np1_a 1 slide2d_20mm
 for ranks in 2 4 8; do run "slide2d_5mm_np${ranks}_a" "$ranks" slide2d_5mm; done
 run slide3d_20mm_np8_a 8 slide3d_20mm
 run rebalance_5mm_np2 2 slide2d_5mm_rebalance 0
-"$build/bench/bench_halos" "$out/slide2d_5mm.yaml" 0.1 8:25 64:16 512:8 4096:4 --json "$out/halos_2d.json" > "$out/halos_2d.txt"
-"$build/bench/bench_halos" "$out/slide2d_5mm.yaml" 0.1 8:25 64:32 512:16 4096:8 --depth 1.0 200 \
+"$build/bench/bench_halos" "$out/slide2d_5mm.yaml" 0.13 8:25 64:16 512:8 4096:4 --json "$out/halos_2d.json" > "$out/halos_2d.txt"
+"$build/bench/bench_halos" "$out/slide2d_5mm.yaml" 0.25 8:25 64:32 512:16 4096:8 --depth 1.0 200 \
   --json "$out/halos_3d.json" > "$out/halos_3d.txt"
-"$build/bench/bench_halos" "$out/slide2d_20mm.yaml" 0.1 8:16 --depth 0.2 10 --json "$out/halos_3d_20mm.json" \
+"$build/bench/bench_halos" "$out/slide2d_20mm.yaml" 0.25 8:16 --depth 0.2 10 --json "$out/halos_3d_20mm.json" \
   > "$out/halos_3d_20mm.txt"
 "$python" "$root/bench/scaling.py" model "$out"

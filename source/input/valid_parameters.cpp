@@ -119,9 +119,9 @@ void defineDomain(ParameterList& domain)
   define(domain, "gravity", zeros(2), "Gravitational acceleration, e.g. [0, -9.81] in 2-D with y up.",
          required(perDirection(unit("m/s^2"))));
   define(domain, "rebalance_interval", 0,
-         "Every this many steps (from step 0) the patches are divided among the ranks again with METIS, each "
-         "patch weighed by the work of its cells and particles, and the run moves to the new division when it "
-         "lowers the estimated imbalance by more than 2 % of the mean load (doc/scaling.md). 0: never; the "
+         "Every this many steps (from step 0) the patches are divided among the ranks again with METIS so that "
+         "the cells' work and the particles' work are each balanced, and the run moves to the new division when "
+         "that lowers the estimated imbalance by more than 2 % of the mean load (doc/scaling.md). 0: never; the "
          "division by cell counts of the start is kept.",
          atLeast(0));
 }

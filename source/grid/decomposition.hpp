@@ -1,7 +1,8 @@
 #pragma once
 // Decomposition of the patches among MPI ranks by METIS, on the graph whose vertices are patches
-// (weighted by work: cells plus, later, particles) and whose edges join face neighbours (weighted by
-// the number of cells on the shared face, the halo traffic between them).
+// (weighted by work: their cells, and for a rebalance their cells and particles as two weights, each
+// balanced on its own) and whose edges join face neighbours (weighted by the number of cells on the
+// shared face, the halo traffic between them).
 #include "grid/grid.hpp"
 
 #include <vector>

@@ -222,6 +222,10 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
   auto kappa = compressibility_.view();
   auto sum_kappa = mixture_compressibility_.view();
   const auto p_ref = solid_reference_pressure_.view();
+  const auto ijk = layout_->cellIndex();
+  const long long nx = layout_->grid().cells()[0], ny = layout_->grid().cells()[1];
+  Kokkos::View<long long, MemorySpace> first("first failed cell");
+  Kokkos::deep_copy(first, std::numeric_limits<long long>::max());
   int failures = 0;
   const auto kernel = [&](auto count, auto with_solids) {
     constexpr int N = decltype(count)::value;
@@ -252,7 +256,11 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
           } else {
             r = ice::equilibrationPressure<N>(nm, eos, mass_density, temperature, p(c, 0));
           }
-          if (!r.converged()) ++failed;
+          if (!r.converged()) {
+            ++failed;
+            const long long gid = ijk(c, 0) + nx * (ijk(c, 1) + (Dim == 3 ? ny * ijk(c, 2) : 0));
+            Kokkos::atomic_fetch_min(&first(), gid);
+          }
           p(c, 0) = r.pressure;
           double sk = 0;
           for (int m = 0; m < nm; ++m) {
@@ -276,6 +284,12 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
     f->exchangeHalo();
   int total = 0;
   Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_SUM, failures, Teuchos::outArg(total));
+  first_failed_equilibration_ = -1;
+  if (total > 0) {
+    long long local_first = 0;
+    Kokkos::deep_copy(local_first, first);
+    Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_MIN, local_first, Teuchos::outArg(first_failed_equilibration_));
+  }
   return total;
 }
 
@@ -815,6 +829,7 @@ void IceSolver<Dim>::equilibrationPhase(CellState<Dim>& state, IceStepReport& re
   Teuchos::TimeMonitor phase(*timers_.at("equilibration"));
   Kokkos::deep_copy(delta_p_.view(), state.pressure.view());  // the previous step's pressure (δp is reset before use)
   report.equilibration_failures = equilibrate(state);
+  report.first_failed_equilibration = first_failed_equilibration_;
   Kokkos::deep_copy(equilibrium_pressure_.view(), state.pressure.view());
   const auto before = delta_p_.view();
   const auto after = state.pressure.view();

@@ -56,6 +56,7 @@ struct IceStepReport {
   double outer_residual = 0;      // max |rhs| / V at the end (a fraction of the cell volume)
   bool converged = true;          // the outer iteration reached outer_tolerance
   int equilibration_failures = 0; // cells whose equilibration pressure did not converge
+  long long first_failed_equilibration = -1;  // global id of the lowest of them, or -1
   // Largest |p_eq − p| over the cells (Pa): how far the equilibration moved the pressure that the
   // previous step ended with. The previous pressure equation made room for the volumes it foresaw;
   // a jump is a volume that arrived unforeseen (by advection or by the particles) divided by the
@@ -159,6 +160,8 @@ class IceSolver {
   /// Brings the state's volume fractions, specific volumes and pressure to equilibrium (step [3]);
   /// returns the number of cells that did not converge.
   int equilibrate(CellState<Dim>& state);
+  /// Global id of the lowest cell whose last equilibrate() did not converge, or -1.
+  long long firstFailedEquilibration() const { return first_failed_equilibration_; }
 
   const IceSettings& settings() const { return settings_; }
 
@@ -198,6 +201,7 @@ class IceSolver {
   FaceField<Dim> face_specific_volume_; // per material, after the face exchange
   FaceField<Dim> face_beta_;            // Σ θ_f v_f
   FaceField<Dim> solid_face_share_;     // solidFaceShares()
+  long long first_failed_equilibration_ = -1;  // firstFailedEquilibration()
   Field<Dim> solid_volume_change_;      // solidVolumeChange()
   FaceField<Dim> solid_kinematic_velocity_;  // a solid's face velocity before pressure and exchange
   FaceField<Dim> fluid_face_fraction_;  // with solids: a fluid's volume fraction crossing a face (columns 2 m, 2 m + 1: donor below, above)

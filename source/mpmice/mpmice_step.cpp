@@ -63,6 +63,17 @@ template <int Dim>
 MpmIceStep<Dim>::~MpmIceStep() = default;
 
 template <int Dim>
+std::string MpmIceStep<Dim>::cellName(long long global_id) const
+{
+  const auto cell = layout_->grid().cellIndex(global_id);
+  std::ostringstream name;
+  name << "cell (" << cell[0] << ", " << cell[1];
+  if (Dim == 3) name << ", " << cell[2];
+  name << ")";
+  return name.str();
+}
+
+template <int Dim>
 CoupledStepReport MpmIceStep<Dim>::step(CellState<Dim>& state, double dt)
 {
   CoupledStepReport report;
@@ -86,6 +97,14 @@ CoupledStepReport MpmIceStep<Dim>::step(CellState<Dim>& state, double dt)
     {
       Teuchos::TimeMonitor phase(*timers_.at("3-6 fluid pressure"));
       ice_->equilibrationPhase(state, report.ice);
+      if (report.ice.equilibration_failures > 0) {
+        std::ostringstream message;
+        message << "coupled step: the equilibration pressure did not converge in " << report.ice.equilibration_failures
+                << " cell(s), the first at " << cellName(report.ice.first_failed_equilibration)
+                << "; its materials' densities admit no common pressure (a material compressed beyond what its "
+                   "equation of state represents; reduce the time step or check the materials' parameters)";
+        throw StepFailure(message.str());
+      }
       ice_->faceVelocityPhase(state, dt);
       ice_->pressurePhase(state, dt, report.ice);
       ice_->momentumSourcePhase(state, dt);
@@ -99,9 +118,7 @@ CoupledStepReport MpmIceStep<Dim>::step(CellState<Dim>& state, double dt)
       const long long cell = report.ice.first_failed_cell;
       std::ostringstream message;
       message << "coupled step: the momentum exchange gave values that are not finite in " << report.ice.exchange_failures
-              << " cell(s), the first at cell " << cell << " (i = " << cell % layout_->grid().cells()[0]
-              << ", j = " << (cell / layout_->grid().cells()[0]) % layout_->grid().cells()[1]
-              << "); a material's density, volume fraction or velocity there is not finite (reduce the time step "
+              << " cell(s), the first at " << cellName(cell) << "; a material's density, volume fraction or velocity there is not finite (reduce the time step "
                  "or check the materials' parameters)";
       throw StepFailure(message.str());
     }
@@ -186,10 +203,8 @@ void MpmIceStep<Dim>::checkFinite(const CellState<Dim>& state) const
   if (global_first != LLONG_MAX) {
     const long long gid = global_first / kKeysPerCell;
     const int f = int(global_first % kKeysPerCell) / 32, column = int(global_first % 32);
-    const auto cell = layout_->grid().cellIndex(gid);
     std::ostringstream message;
-    message << "coupled step: cell (" << cell[0] << ", " << cell[1] << (Dim == 3 ? ", " + std::to_string(cell[2]) : "")
-            << "): ";
+    message << "coupled step: " << cellName(gid) << ": ";
     const std::string& field = fields[f]->name();
     if (fields[f] == &state.pressure) {
       message << "the pressure";

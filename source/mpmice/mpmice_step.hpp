@@ -81,6 +81,8 @@ class MpmIceStep {
   /// [12] Throws StepFailure naming the first cell (lowest global id) or particle (lowest id), its
   /// material and the quantity, if a value of the state or of a particle is not finite.
   void checkFinite(const CellState<Dim>& state) const;
+  /// "cell (i, j)" or "cell (i, j, k)" for a global cell id, for messages.
+  std::string cellName(long long global_id) const;
 
   Scene scene_;
   std::shared_ptr<const Layout<Dim>> layout_;

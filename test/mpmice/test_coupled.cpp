@@ -228,6 +228,35 @@ TEST(CoupledStep, ExchangeConservesMomentum)
   EXPECT_NEAR(end - start, impulse, 1e-10 * std::abs(disk0));
 }
 
+// No silent failures: a cell whose materials admit no common pressure (here air at a temperature
+// below zero, whose ideal-gas density has no positive root, next to water) stops the step with the
+// cell named, as a failed step that the driver can retry (StepFailure), not a pressure left
+// unconverged.
+TEST(CoupledStep, FailedEquilibrationNamesTheCell)
+{
+  CoupledRun<2> run(sceneFromYaml(tankScene(0.2, 0.2, 20, 20, 0.15, withDensity(kElasticBlock, 1500.0),
+                                            "    b: {material: block, shape: box, lower: [0.07, 0.08], upper: [0.13, 0.12]}")),
+                    world());
+  run.step(1.0);  // a healthy first step
+  const int air = 2;  // block, water, air
+  const auto ijk = run.layout->cellIndex();
+  auto T = run.state.temperature.view();
+  for (LocalOrdinal c = 0; c < run.state.temperature.ownedCount(); ++c)
+    if (ijk(c, 0) == 4 && ijk(c, 1) == 17) T(c, air) = -100.0;  // in the air above the water (y = 0.175 m)
+  bool named = false, failed = false;
+  try {
+    run.step(1.0);
+  } catch (const StepFailure& failure) {
+    failed = true;
+    const std::string message = failure.what();
+    named = message.find("equilibration pressure did not converge in 1 cell(s), the first at cell (4, 17)") !=
+            std::string::npos;
+    if (!named && world()->getRank() == 0) std::printf("message: %s\n", message.c_str());
+  }
+  EXPECT_TRUE(failed);
+  EXPECT_TRUE(named);
+}
+
 // (f) The same coupled scene (a dense block sinking through water under air) on rank 0 alone and on
 // all ranks: particle positions (matched by id) and the water's volume fraction agree to 1e-8 of their
 // scales (the tank's width; a full cell). Partitions change only the order of sums in the linear

@@ -424,8 +424,16 @@ LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, d
           const double phi = limiter(value, lo, hi, spread, remaining > 0 ? remaining : 0.0, S);
           double slab_mass[2 * Dim];
           double left = value;  // the mass that stays in the cell
+          double leaving = 0;
           for (int f = 0; f < 2 * Dim; ++f) {
             slab_mass[f] = fraction[f] * (value + phi * slope[f]) * (capped ? outflow_share(c, f) : 1.0);
+            leaving += slab_mass[f];
+          }
+          // Next to a solid the fluids fill the room it leaves on a face (a share above 1), which
+          // may ask for more than the cell holds: then all of it leaves, in proportion.
+          const double bound = capped && leaving > value && leaving > 0 ? (value > 0 ? value : 0.0) / leaving : 1.0;
+          for (int f = 0; f < 2 * Dim; ++f) {
+            slab_mass[f] *= bound;
             outflow_mass(c, f, m) = slab_mass[f];
             if (slab_densities) slab_density(c, f, m) = value + phi * slope[f];
             left -= slab_mass[f];

@@ -74,9 +74,11 @@ class Advector {
   /// Input ghosts are refreshed before the step and output ghosts after it. If the status is not
   /// ok, nothing is changed.
   /// - outflow_share (optional, (local cell, face f = 2 d + side), owned and ghost cells): the share
-  ///   of each slab's profile that leaves, in [0, 1] (1 where not given): with solids in the cells,
-  ///   the room the solids leave the fluids on a face over what the profiles hold
-  ///   (IceSolver::fluidFaceFractions).
+  ///   of each slab's profile that leaves (1 where not given): with solids in the cells, the room
+  ///   the solids leave the fluids on a face over what the profiles hold
+  ///   (IceSolver::fluidFaceFractions); above 1 next to a solid, whose edge the profile cannot hold.
+  ///   A cell never gives more than its mass: if the slabs ask for more, all of it leaves, in
+  ///   proportion.
   using CapView = Kokkos::View<double**, MemorySpace>;
   AdvectionStatus advect(FaceField<Dim>& face_velocity, double dt, Field<Dim>& mass,
                          const std::vector<Field<Dim>*>& mass_specific, const CapView& outflow_share = CapView());

@@ -153,9 +153,13 @@ struct Tait {
   }
 };
 
-/// Bulk response of an MPM solid for the equilibration pressure (the form of Uintah's MPM
-/// constitutive models' computePressEOSCM): p = p_ref + K (1 - rho0/rho). Temperature is not used.
-/// Parameters: K [Pa] bulk modulus, rho0 [kg/m^3], p_ref [Pa].
+/// Bulk response of an MPM solid for the equilibration pressure: p = p_ref + K ln(rho/rho0), the
+/// logarithmic form of Uintah's p = p_ref + K (1 - rho0/rho) (computePressEOSCM), the same to first
+/// order in the strain. The logarithm has no pressure at which the solid cannot be compressed further:
+/// in a cell whose fluids alone overfill it (a sand front arriving before the water has left) the
+/// pressure rises until the fluids fit and the solid's share shrinks as exp(-(p - p_ref)/K), where the
+/// rational form ends at p_ref + K and the equilibration had no root.
+/// Parameters: K [Pa] bulk modulus, rho0 [kg/m^3], p_ref [Pa]. Temperature is not used.
 struct SolidEos {
   double bulk_modulus;        // K [Pa]
   double reference_density;   // rho0 [kg/m^3]
@@ -169,24 +173,17 @@ struct SolidEos {
 
   KOKKOS_INLINE_FUNCTION double pressure(double rho, double) const
   {
-    return reference_pressure + bulk_modulus * (1.0 - reference_density / rho);
+    return reference_pressure + bulk_modulus * Kokkos::Experimental::log(rho / reference_density);
   }
-  /// dp/drho = K rho0/rho^2.
-  KOKKOS_INLINE_FUNCTION double dp_drho(double rho, double) const
-  {
-    return bulk_modulus * reference_density / (rho * rho);
-  }
+  /// dp/drho = K/rho.
+  KOKKOS_INLINE_FUNCTION double dp_drho(double rho, double) const { return bulk_modulus / rho; }
   KOKKOS_INLINE_FUNCTION double density(double p, double) const
   {
-    return reference_density / (1.0 - (p - reference_pressure) / bulk_modulus);
+    return reference_density * Kokkos::Experimental::exp((p - reference_pressure) / bulk_modulus);
   }
-  /// c^2 = dp/drho = K rho0/rho^2, so the compressibility 1/(rho c^2) = rho/(K rho0) is the
-  /// derivative of this EOS. (Uintah uses c^2 = K/rho, compressibility 1/K: equal at rho = rho0.)
+  /// c^2 = dp/drho = K/rho, so the compressibility 1/(rho c^2) = 1/K, Uintah's.
   KOKKOS_INLINE_FUNCTION double sound_speed_squared(double rho, double T) const { return dp_drho(rho, T); }
-  KOKKOS_INLINE_FUNCTION PressureRange pressure_range(double) const
-  {
-    return {-DBL_MAX, reference_pressure + bulk_modulus};
-  }
+  KOKKOS_INLINE_FUNCTION PressureRange pressure_range(double) const { return {-DBL_MAX, DBL_MAX}; }
 };
 
 enum class EosKind : int { None = 0, IdealGas, LinearWater, Tait, Solid };

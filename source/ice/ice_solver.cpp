@@ -28,6 +28,12 @@ constexpr double kNegligibleMassShare = 1e-12;
 // Likewise on a face: a material filling less than this share of both neighbours has no face
 // velocity of its own (a denormal volume fraction would leave it uncoupled by the exchange).
 constexpr double kNegligibleVolumeShare = 1e-12;
+// Next to a solid the fluids fill the room it leaves on a face (fluidFaceFractions) where the donor
+// holds more than kSolidPresent of solids and its fluids' profiles more than kFillMinimum of the face.
+constexpr double kSolidPresent = 1e-6;
+constexpr double kFillMinimum = 1e-3;
+// Order of the odd-even filter: κ δ^(2 kOddEvenFilterOrder) per direction (filterOddEven).
+constexpr int kOddEvenFilterOrder = 2;
 
 // Gives every material of a cell that holds a negligible share of its mass the mixture's
 // (mass-weighted) velocity, so that its meaningless own value can neither limit the time step nor
@@ -101,6 +107,7 @@ IceSettings IceSettings::fromScene(const Scene& scene)
   s.solver_tolerance_given = ice.get<double>("solver_tolerance") > 0;
   s.solver_tolerance = s.solver_tolerance_given ? ice.get<double>("solver_tolerance") : 1e-10;
   s.dt_growth = ice.get<double>("dt_growth");
+  s.odd_even_filter = ice.get<double>("odd_even_filter");
   if (ice.isSublist("linear_solver")) s.linear_solver = ice.sublist("linear_solver");
   s.linear_solver.set("tolerance", s.solver_tolerance);
   // The pressure matrix changes little from step to step: between full MueLu set-ups (every 50
@@ -136,6 +143,9 @@ IceSolver<Dim>::IceSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>>
       solid_kinematic_velocity_(layout, solids.empty() ? 1 : materials_, "solid_kinematic_velocity"),
       fluid_face_fraction_(layout, solids.empty() ? 1 : 2 * materials_, "fluid_face_fraction"),
       new_velocity_(layout, Location::Cell, materials_ * Dim, "new_velocity"),
+      filter_level_a_(layout, Location::Cell, materials_ * Dim, "odd-even filter level a"),
+      filter_level_b_(layout, Location::Cell, materials_ * Dim, "odd-even filter level b"),
+      filter_increment_(layout, Location::Cell, materials_ * Dim, "odd-even filter increment"),
       old_specific_volume_(layout, Location::Cell, materials_, "old_specific_volume"),
       solid_reference_pressure_(layout, Location::Cell, 1, "solid_reference_pressure")
 {
@@ -433,19 +443,64 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
             out(c, 2 * m + 1) = slab(c, 2 * d, m) * v(c, m);
             fluid[0] += out(c, 2 * m), fluid[1] += out(c, 2 * m + 1);
           }
-          // The fluids cross a face in at most the room the solids leave there: a cell's linear
-          // profile cannot hold the sharp edge of a solid inside the cell, and above a sand
-          // surface it would carry water down through a face that the sand covers (and trap it in
-          // the sand's cells, where a share of 1e-3 is ~30 kPa of the sand's bulk modulus).
+          // The fluids cross a face in the room the solids leave there. A cell's linear profile
+          // cannot hold the sharp edge of a solid inside the cell: above a sand surface it would
+          // carry water down through a face that the sand covers (and trap it in the sand's cells,
+          // where a share of 1e-3 is ~30 kPa of the sand's bulk modulus), so the fluids never take
+          // more than the room. Where the donor holds a solid they take all of it, in proportion to
+          // their profiles: ahead of a sand front inside a cell, all the water between the front
+          // and the face leaves through the face (the profile put only 0.3-0.75 of it there, so that
+          // the water left faster than the front by that factor, and the front cell's pressure
+          // peak drove the water ahead). A donor whose fluids' profiles hold less than
+          // kFillMinimum of the face keeps its profile (a nearly dry cell does not fill a face).
           double keep[2];
           for (int side = 0; side < 2; ++side) {
             const double room = solid[side] < 1.0 ? 1.0 - solid[side] : 0.0;
-            keep[side] = fluid[side] > room ? room / fluid[side] : 1.0;
+            const LocalOrdinal donor = side == 0 ? l : c;
+            double donor_solid = 0;
+            if (donor >= 0)
+              for (int m = 0; m < n; ++m)
+                if (roles.lagrangian[m] || roles.rigid[m]) donor_solid += theta(donor, m);
+            const bool fill = donor_solid > kSolidPresent && fluid[side] > kFillMinimum;
+            keep[side] = fluid[side] > 0 && (fill || fluid[side] > room) ? room / fluid[side] : 1.0;
           }
           for (int m = 0; m < n; ++m)
             for (int side = 0; side < 2; ++side) out(c, 2 * m + side) *= keep[side];
           if (l >= 0) leaves(l, 2 * d + 1) = keep[0];
           leaves(c, 2 * d) = keep[1];
+        });
+  }
+}
+
+// [5] With solids in the cells, the pressure matrix's face coefficient β = Σ_m v_f,m θ_m with the
+// volume fraction θ_m that each material's flux carries (pressureRightHandSide): a fluid's from
+// fluidFaceFractions, a deformable solid's share of the face, none for a rigid body. Which side the
+// flux comes from is not known before the correction: the larger of the two, which never assumes
+// less response than the flux has, so that the outer iterations contract.
+template <int Dim>
+void IceSolver<Dim>::carriedFaceBeta()
+{
+  const int n = materials_;
+  const auto neighbours = layout_->cellNeighbours();
+  const auto roles = roles_;
+  for (int d = 0; d < Dim; ++d) {
+    const auto vf = face_specific_volume_.direction(d).view();
+    const auto fluid = fluid_face_fraction_.direction(d).view();
+    const auto share = solid_face_share_.direction(d).view();
+    auto beta = face_beta_.direction(d).view();
+    Kokkos::parallel_for(
+        "ice::carriedFaceBeta", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->overlapCells()),
+        KOKKOS_LAMBDA(const LocalOrdinal c) {
+          if (neighbours(c, 2 * d) < 0) return;  // a wall, or a ghost's outer face: as faceVelocities left it
+          double b = 0;
+          for (int m = 0; m < n; ++m) {
+            if (roles.rigid[m]) continue;
+            const bool solid = roles.lagrangian[m];
+            const double below = solid ? Kokkos::Experimental::fmin(1.0, share(c, 2 * m)) : fluid(c, 2 * m);
+            const double above = solid ? Kokkos::Experimental::fmin(1.0, share(c, 2 * m + 1)) : fluid(c, 2 * m + 1);
+            b += vf(c, m) * Kokkos::Experimental::fmax(below, above);
+          }
+          beta(c, 0) = b > 0 ? b : 0.0;
         });
   }
 }
@@ -693,6 +748,92 @@ void IceSolver<Dim>::momentumSourcePhase(CellState<Dim>& state, double dt)
   });
 }
 
+// [7] The fluids' cell velocities lose their odd-even part (`ice.odd_even_filter`, on by default in
+// scenes with solids). On a collocated grid a velocity that alternates from cell to cell is invisible
+// to the pressure: the face velocities average it away and the cell-centred pressure force (a central
+// difference of face pressures) cannot act on it. Where a cell's pressure stands above its
+// neighbours' (the cell at a sand front that the water must leave) the central difference pushes the
+// next cell but not the one after, and the water ahead of the slide's front took up an odd-even
+// pattern from the first steps (40 mm: u_x = 0.024, 0.007, 0.018, 0.006 m/s in successive columns
+// at 0.01 s, 0.43, 0.01, 0.27, 0.00 at 0.1 s) that grew until the run failed, whatever the time
+// step. The filter, u −= κ Σ_d δ_d⁴ u per step with δ_d the second difference in direction d,
+// removes the share 16 κ (`odd_even_filter`) of the odd-even mode of each direction and
+// (2 sin(π/N))⁴ κ of a wave of N cells: with 0.25, 1.5e-4 of a 20-cell wave per step, so that its
+// effect on resolved flow vanishes as h⁴/Δt under refinement. A sixth-order filter (δ⁶, sharper)
+// that removed a quarter or a third of the odd-even mode per step let the slide fail at 0.13 s as
+// without a filter (the pattern at the front spans three to four cells, which δ⁶ spares), and so
+// did δ⁴ removing 1/16. Written as fluxes of momentum between neighbours,
+// m_i Δu_i = Σ_o F_io with F_io = −F_oi, it conserves each fluid's momentum; a face's weight is the
+// smaller of the two cells' densities of the fluid (none across a free surface into cells the fluid
+// does not fill, or at a wall).
+template <int Dim>
+void IceSolver<Dim>::filterOddEven(const CellState<Dim>& state)
+{
+  // The odd-even mode of one direction is an eigenvector of δ² with eigenvalue −4.
+  constexpr int order = kOddEvenFilterOrder;
+  const double kappa = settings_.odd_even_filter / std::pow(4.0, order);
+  if (!(kappa > 0)) return;
+  const int n = materials_;
+  const int columns = n * Dim;
+  const auto neighbours = layout_->cellNeighbours();
+  const auto rho = state.density.view();
+  const auto roles = roles_;
+  auto un = new_velocity_.view();
+  auto increment = filter_increment_.view();
+  Kokkos::deep_copy(increment, 0.0);
+  new_velocity_.exchangeHalo();
+  // (−1)^(order+1) κ δ^(2 order): damping for either parity of the order.
+  const double sign = order % 2 == 1 ? 1.0 : -1.0;
+  for (int d = 0; d < Dim; ++d) {
+    // level ← δ_d² level, (order − 1) times, from the velocities; then the fluxes of the last level.
+    typename Field<Dim>::ConstView from = un;
+    for (int pass = 0; pass + 1 < order; ++pass) {
+      Field<Dim>& to_field = pass % 2 == 0 ? filter_level_a_ : filter_level_b_;
+      auto to = to_field.view();
+      Kokkos::parallel_for(
+          "ice::filterLevel", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+          KOKKOS_LAMBDA(const LocalOrdinal c) {
+            for (int col = 0; col < columns; ++col) {
+              const int m = col / Dim;
+              const double rc = rho(c, m);
+              double sum = 0;
+              if (!roles.lagrangian[m] && !roles.rigid[m] && rc > 0)
+                for (int side = 0; side < 2; ++side) {
+                  const LocalOrdinal o = neighbours(c, 2 * d + side);
+                  if (o < 0) continue;
+                  const double ro = rho(o, m);
+                  sum += Kokkos::Experimental::fmin(rc, ro) / Kokkos::Experimental::fmax(rc, ro) * (from(o, col) - from(c, col));
+                }
+              to(c, col) = sum;
+            }
+          });
+      to_field.exchangeHalo();
+      from = to_field.view();
+    }
+    Kokkos::parallel_for(
+        "ice::filterFlux", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+        KOKKOS_LAMBDA(const LocalOrdinal c) {
+          for (int col = 0; col < columns; ++col) {
+            const int m = col / Dim;
+            const double rc = rho(c, m);
+            if (roles.lagrangian[m] || roles.rigid[m] || !(rc > 0)) continue;
+            double flux = 0;
+            for (int side = 0; side < 2; ++side) {
+              const LocalOrdinal o = neighbours(c, 2 * d + side);
+              if (o < 0) continue;
+              flux += Kokkos::Experimental::fmin(rc, rho(o, m)) * (from(o, col) - from(c, col));
+            }
+            increment(c, col) += sign * kappa * flux / rc;
+          }
+        });
+  }
+  Kokkos::parallel_for(
+      "ice::filterApply", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+      KOKKOS_LAMBDA(const LocalOrdinal c) {
+        for (int col = 0; col < columns; ++col) un(c, col) += increment(c, col);
+      });
+}
+
 // [8] The implicit cell-centred momentum exchange (Uintah addExch_Vel_Temp_CC, momentum part) on the
 // Lagrangian velocities, pointwise; a material with a negligible share of the mass then takes the
 // mixture's velocity. A rigid material enters with an inertia that keeps its velocity (kRigidInertia).
@@ -702,6 +843,7 @@ template <int Dim>
 void IceSolver<Dim>::exchangePhase(CellState<Dim>& state, double dt, IceStepReport& report)
 {
   Teuchos::TimeMonitor phase(*timers_.at("exchange"));
+  filterOddEven(state);
   const int n = materials_;
   const auto theta = state.volume_fraction.view();
   const auto rho = state.density.view();
@@ -861,8 +1003,11 @@ void IceSolver<Dim>::pressurePhase(CellState<Dim>& state, double dt, IceStepRepo
   Teuchos::TimeMonitor phase(*timers_.at("pressure"));
   sum_delta_p_.fill(0.0);
   const bool implicit = settings_.pressure == "implicit";
+  if (roles_.any_solid) {
+    fluidFaceFractions(state, dt);
+    carriedFaceBeta();
+  }
   if (implicit) pressure_solver_->assemble(mixture_compressibility_, face_beta_, dt);
-  if (roles_.any_solid) fluidFaceFractions(state, dt);
   double residual = pressureRightHandSide(state, dt, false);
   while (residual > settings_.outer_tolerance && report.outer_iterations < settings_.max_outer_iterations) {
     ++report.outer_iterations;
@@ -1010,10 +1155,17 @@ TimeStepLimit IceSolver<Dim>::stableTimeStep(const CellState<Dim>& state, double
           if (s > worst) worst = s;
         },
         Kokkos::Max<double>(rate));
+    // A material that the exchange holds to the others of its cell within the step (β = Δt v_m K
+    // Σ_n θ_n above 1) does not limit the viscous step: its explicit viscous change is the force
+    // θ μ ∇²u on it whatever its density, and the exchange gives it the mixture's velocity. (Air
+    // expanded into a gap of the sand's cells, at tens of Pa, had ν = μ v ~ 0.1 m²/s and a viscous
+    // step of 1e-6 s.)
+    const double K = settings_.exchange_coefficient;
     Kokkos::parallel_reduce(
         "ice::viscousLimit", Kokkos::RangePolicy<ExecutionSpace>(0, state.velocity.ownedCount()),
         KOKKOS_LAMBDA(const LocalOrdinal c, double& worst) {
           if (theta(c, m) < 1e-6) return;
+          if (previous_dt * v(c, m) * K * (1.0 - theta(c, m)) > 1.0) return;
           if (v(c, m) > worst) worst = v(c, m);
         },
         Kokkos::Max<double>(max_nu));

@@ -44,6 +44,7 @@ struct IceSettings {
   double solver_tolerance = 0;           // relative residual of each linear solve (when given)
   bool solver_tolerance_given = false;   // false: each solve goes as far as the outer test needs
   double dt_growth = 0;                  // largest ratio of successive time steps
+  double odd_even_filter = 0;            // share of the fluids' odd-even mode removed per step
   Teuchos::ParameterList linear_solver;  // passed to PressureSolver
 
   static IceSettings fromScene(const Scene& scene);
@@ -120,6 +121,8 @@ class IceSolver {
   /// [8] Lagrangian specific volume, implicit cell-centred momentum exchange between all
   /// materials, and energy (unless isothermal); the exchanged velocities become the state's.
   void exchangePhase(CellState<Dim>& state, double dt, IceStepReport& report);
+  void filterOddEven(const CellState<Dim>& state);
+  void carriedFaceBeta();
   /// [10] Advection of the fluids (solids are Lagrangian) and the cell closure θ = ρ v.
   void advectionPhase(CellState<Dim>& state, double dt, IceStepReport& report);
 
@@ -207,6 +210,7 @@ class IceSolver {
   FaceField<Dim> fluid_face_fraction_;  // with solids: a fluid's volume fraction crossing a face (columns 2 m, 2 m + 1: donor below, above)
   typename Advector<Dim>::CapView fluid_outflow_share_;  // with solids: (donor cell, face) share of the fluids' slabs that leaves
   Field<Dim> new_velocity_;             // Lagrangian velocities between sources and exchange
+  Field<Dim> filter_level_a_, filter_level_b_, filter_increment_;  // filterOddEven's work space
   Field<Dim> old_specific_volume_;      // v before the Lagrangian update (for the p dv work)
   Field<Dim> solid_reference_pressure_; // p_ref of the solids' equation of state per cell (Pa)
   std::unique_ptr<PressureSolver<Dim>> pressure_solver_;

@@ -1018,7 +1018,6 @@ Scene readSceneText(const std::string& file_text, const std::string& path)
     // 2. The top level: known sections of the right type, required ones present, optional ones added.
     const ParameterList& valid = *validSceneParameters();
     checkKeys(*root, valid, kRoot, 0);
-    const bool filter_given = root->isSublist("ice") && root->sublist("ice").isParameter("odd_even_filter");
     setDefaults(*root, valid, kRoot);
 
     // 3. Each section, the domain first (its dimension sets the length of per-direction lists),
@@ -1034,13 +1033,6 @@ Scene readSceneText(const std::string& file_text, const std::string& path)
     scene.output = readOutput(root->sublist("output"));
     scene.mpm = readMpm(root->sublist("mpm"));
     checkedSection(root->sublist("ice"), "ice");  // read by the ICE solver (IceSettings::fromScene)
-    if (!filter_given) {
-      // The odd-even filter's default: on where solids meet the fluids (the front of a solid is
-      // where a collocated pressure drives the mode), off for fluids alone (their numerics as before).
-      bool solids = false;
-      for (const MaterialSpec& m : scene.materials) solids = solids || m.kind == "solid";
-      root->sublist("ice").set("odd_even_filter", solids ? kDefaultOddEvenFilter : 0.0);
-    }
 
     // 4. The scene as a whole: what the regions place, the solvers' own settings, derived
     //    quantities, the grid's size (input/scene_checks.hpp).

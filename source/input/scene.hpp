@@ -13,9 +13,6 @@
 
 namespace cfdmpm {
 
-/// Default of `ice.odd_even_filter` in scenes with solids (scenes of fluids alone: 0).
-inline constexpr double kDefaultOddEvenFilter = 0.25;
-
 struct DomainSpec {
   int dimension = 2;                          // 2 or 3
   std::array<double, 3> lower{0, 0, 0};       // m; unused dimensions 0

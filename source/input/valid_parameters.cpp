@@ -233,11 +233,11 @@ void defineIce(ParameterList& ice)
          "the right-hand side if that comes first.",
          between(0, false, 1e-2, true));
   define(ice, "dt_growth", 1.2, "Largest ratio of successive time steps.", greaterThan(1));
-  define(ice, "odd_even_filter", kDefaultOddEvenFilter,
+  define(ice, "odd_even_filter", 0.0,
          "Share of the fluids' odd-even velocity mode (alternating from cell to cell, which a collocated "
-         "pressure cannot see) that a momentum-conserving filter removes per step in each direction "
-         "(doc/mpmice.md); 0: off.",
-         derivedDefault(between(0, false, 1, false), "0.25 in scenes with solids, 0 in scenes of fluids alone"));
+         "pressure cannot see) that a momentum-conserving filter removes per step in each direction where the "
+         "velocity zigzags (doc/mpmice.md); 0: off. input/rzadkiewicz.yaml uses 0.25.",
+         between(0, false, 1, false));
   defineSection(ice, "linear_solver",
                 "Settings of the pressure solver (preconditioner, MueLu reuse, ...), checked by it; keys given "
                 "replace cfdmpm's defaults one by one (doc/ice-pressure.md).",

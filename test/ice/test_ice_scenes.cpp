@@ -388,11 +388,11 @@ TEST(IceScenes, OddEvenFilterRemovesTheModeTheCollocatedPressureCannotSee)
   EXPECT_NEAR(momentumX(on), momentum0, 1e-10);
 }
 
-TEST(IceScenes, OddEvenFilterIsOnWithSolidsOnlyByDefault)
+TEST(IceScenes, OddEvenFilterIsOffByDefaultAndOnInTheSlide)
 {
   const Scene fluids = checkerboardScene("");
   EXPECT_EQ(fluids.parameters->sublist("ice").get<double>("odd_even_filter"), 0.0);
   EXPECT_EQ(IceSettings::fromScene(fluids).odd_even_filter, 0.0);
   const Scene slide = readScene(std::string(CFDMPM_SOURCE_DIR) + "/input/rzadkiewicz.yaml");
-  EXPECT_EQ(IceSettings::fromScene(slide).odd_even_filter, kDefaultOddEvenFilter);
+  EXPECT_EQ(IceSettings::fromScene(slide).odd_even_filter, 0.25);
 }

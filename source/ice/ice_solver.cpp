@@ -32,8 +32,6 @@ constexpr double kNegligibleVolumeShare = 1e-12;
 // holds more than kSolidPresent of solids and its fluids' profiles more than kFillMinimum of the face.
 constexpr double kSolidPresent = 1e-6;
 constexpr double kFillMinimum = 1e-3;
-// Order of the odd-even filter: κ δ^(2 kOddEvenFilterOrder) per direction (filterOddEven).
-constexpr int kOddEvenFilterOrder = 2;
 
 // Gives every material of a cell that holds a negligible share of its mass the mixture's
 // (mass-weighted) velocity, so that its meaningless own value can neither limit the time step nor
@@ -143,9 +141,10 @@ IceSolver<Dim>::IceSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>>
       solid_kinematic_velocity_(layout, solids.empty() ? 1 : materials_, "solid_kinematic_velocity"),
       fluid_face_fraction_(layout, solids.empty() ? 1 : 2 * materials_, "fluid_face_fraction"),
       new_velocity_(layout, Location::Cell, materials_ * Dim, "new_velocity"),
-      filter_level_a_(layout, Location::Cell, materials_ * Dim, "odd-even filter level a"),
-      filter_level_b_(layout, Location::Cell, materials_ * Dim, "odd-even filter level b"),
-      filter_increment_(layout, Location::Cell, materials_ * Dim, "odd-even filter increment"),
+      filter_laplacian_(layout, Location::Cell, settings_.odd_even_filter > 0 ? materials_ * Dim : 1,
+                        "odd-even filter second difference"),
+      filter_increment_(layout, Location::Cell, settings_.odd_even_filter > 0 ? materials_ * Dim : 1,
+                        "odd-even filter increment"),
       old_specific_volume_(layout, Location::Cell, materials_, "old_specific_volume"),
       solid_reference_pressure_(layout, Location::Cell, 1, "solid_reference_pressure")
 {
@@ -773,47 +772,39 @@ void IceSolver<Dim>::momentumSourcePhase(CellState<Dim>& state, double dt)
 template <int Dim>
 void IceSolver<Dim>::filterOddEven(const CellState<Dim>& state)
 {
-  // The odd-even mode of one direction is an eigenvector of δ² with eigenvalue −4.
-  constexpr int order = kOddEvenFilterOrder;
-  const double kappa = settings_.odd_even_filter / std::pow(4.0, order);
+  // The odd-even mode of one direction is an eigenvector of δ² with eigenvalue −4, of δ⁴ with 16.
+  const double kappa = settings_.odd_even_filter / 16.0;
   if (!(kappa > 0)) return;
-  const int n = materials_;
-  const int columns = n * Dim;
+  const int columns = materials_ * Dim;
   const auto neighbours = layout_->cellNeighbours();
   const auto rho = state.density.view();
   const auto roles = roles_;
   auto un = new_velocity_.view();
   auto increment = filter_increment_.view();
+  const auto laplacian = filter_laplacian_.view();
   Kokkos::deep_copy(increment, 0.0);
   new_velocity_.exchangeHalo();
-  // (−1)^(order+1) κ δ^(2 order): damping for either parity of the order.
-  const double sign = order % 2 == 1 ? 1.0 : -1.0;
   for (int d = 0; d < Dim; ++d) {
-    // level ← δ_d² level, (order − 1) times, from the velocities; then the fluxes of the last level.
-    typename Field<Dim>::ConstView from = un;
-    for (int pass = 0; pass + 1 < order; ++pass) {
-      Field<Dim>& to_field = pass % 2 == 0 ? filter_level_a_ : filter_level_b_;
-      auto to = to_field.view();
-      Kokkos::parallel_for(
-          "ice::filterLevel", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
-          KOKKOS_LAMBDA(const LocalOrdinal c) {
-            for (int col = 0; col < columns; ++col) {
-              const int m = col / Dim;
-              const double rc = rho(c, m);
-              double sum = 0;
-              if (!roles.lagrangian[m] && !roles.rigid[m] && rc > 0)
-                for (int side = 0; side < 2; ++side) {
-                  const LocalOrdinal o = neighbours(c, 2 * d + side);
-                  if (o < 0) continue;
-                  const double ro = rho(o, m);
-                  sum += Kokkos::Experimental::fmin(rc, ro) / Kokkos::Experimental::fmax(rc, ro) * (from(o, col) - from(c, col));
-                }
-              to(c, col) = sum;
-            }
-          });
-      to_field.exchangeHalo();
-      from = to_field.view();
-    }
+    // δ_d² u, with each face weighted by the ratio of the two cells' densities of the fluid.
+    Kokkos::parallel_for(
+        "ice::filterLaplacian", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+        KOKKOS_LAMBDA(const LocalOrdinal c) {
+          for (int col = 0; col < columns; ++col) {
+            const int m = col / Dim;
+            const double rc = rho(c, m);
+            double sum = 0;
+            if (!roles.lagrangian[m] && !roles.rigid[m] && rc > 0)
+              for (int side = 0; side < 2; ++side) {
+                const LocalOrdinal o = neighbours(c, 2 * d + side);
+                if (o < 0) continue;
+                const double ro = rho(o, m);
+                sum += Kokkos::Experimental::fmin(rc, ro) / Kokkos::Experimental::fmax(rc, ro) * (un(o, col) - un(c, col));
+              }
+            laplacian(c, col) = sum;
+          }
+        });
+    filter_laplacian_.exchangeHalo();
+    // −κ δ_d⁴ u as momentum fluxes of δ_d² u between neighbours.
     Kokkos::parallel_for(
         "ice::filterFlux", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
         KOKKOS_LAMBDA(const LocalOrdinal c) {
@@ -828,13 +819,13 @@ void IceSolver<Dim>::filterOddEven(const CellState<Dim>& state)
               // Only where the velocity zigzags across the face: the three differences of the four
               // cells around it (c's other neighbour, c, o, o's other neighbour) alternate in sign.
               // A smooth flow turns at most once in four cells, so it passes untouched.
-              const LocalOrdinal before = neighbours(c, 2 * d + 1 - side), after = o >= 0 ? neighbours(o, 2 * d + side) : -1;
+              const LocalOrdinal before = neighbours(c, 2 * d + 1 - side), after = neighbours(o, 2 * d + side);
               if (before < 0 || after < 0) continue;
               const double d1 = un(c, col) - un(before, col), d2 = un(o, col) - un(c, col), d3 = un(after, col) - un(o, col);
               if (!(d1 * d2 < 0 && d2 * d3 < 0)) continue;
-              flux += Kokkos::Experimental::fmin(rc, rho(o, m)) * (from(o, col) - from(c, col));
+              flux += Kokkos::Experimental::fmin(rc, rho(o, m)) * (laplacian(o, col) - laplacian(c, col));
             }
-            increment(c, col) += sign * kappa * flux / rc;
+            increment(c, col) -= kappa * flux / rc;
           }
         });
   }

@@ -210,7 +210,7 @@ class IceSolver {
   FaceField<Dim> fluid_face_fraction_;  // with solids: a fluid's volume fraction crossing a face (columns 2 m, 2 m + 1: donor below, above)
   typename Advector<Dim>::CapView fluid_outflow_share_;  // with solids: (donor cell, face) share of the fluids' slabs that leaves
   Field<Dim> new_velocity_;             // Lagrangian velocities between sources and exchange
-  Field<Dim> filter_level_a_, filter_level_b_, filter_increment_;  // filterOddEven's work space
+  Field<Dim> filter_laplacian_, filter_increment_;  // filterOddEven's work space (1 column when off)
   Field<Dim> old_specific_volume_;      // v before the Lagrangian update (for the p dv work)
   Field<Dim> solid_reference_pressure_; // p_ref of the solids' equation of state per cell (Pa)
   std::unique_ptr<PressureSolver<Dim>> pressure_solver_;

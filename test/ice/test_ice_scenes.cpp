@@ -86,6 +86,14 @@ TEST(IceScenes, StillWaterStaysStill)
 
 namespace {
 
+// Water without viscosity, as a YAML entry of `materials`.
+constexpr const char* kInviscidWater = R"(    water:
+      kind: fluid
+      equation_of_state: {type: linear_water, bulk_modulus: 2.15e9, reference_density: 998.0, reference_pressure: 101325.0, reference_temperature: 293.15}
+      viscosity: 0.0
+      specific_heat: 4157.0
+)";
+
 // Water at rest in a closed 1 m x 0.02 m channel (200 x 4 cells, 5 mm) with a 0.1 m slug moving
 // at 0.1 m/s in the middle: two acoustic pulses run out from it. No gravity, no air.
 Scene acousticScene(const std::string& pressure_scheme)
@@ -94,12 +102,7 @@ Scene acousticScene(const std::string& pressure_scheme)
 cfdmpm:
   domain: {dimension: 2, lower: [0.0, 0.0], upper: [1.0, 0.02], cells: [200, 4], patch_cells: [25, 4], gravity: [0.0, 0.0]}
   materials:
-    water:
-      kind: fluid
-      equation_of_state: {type: linear_water, bulk_modulus: 2.15e9, reference_density: 998.0, reference_pressure: 101325.0, reference_temperature: 293.15}
-      viscosity: 0.0
-      specific_heat: 4157.0
-  initial_state: {background_material: water, temperature: 293.15, pressure: 101325.0, hydrostatic: false}
+)" + std::string(kInviscidWater) + R"(  initial_state: {background_material: water, temperature: 293.15, pressure: 101325.0, hydrostatic: false}
   regions:
     slug: {material: water, shape: box, lower: [0.45, 0.0], upper: [0.55, 0.02], velocity: [0.1, 0.0]}
   boundary_conditions:
@@ -316,12 +319,7 @@ Scene checkerboardScene(const std::string& filter)
 cfdmpm:
   domain: {dimension: 2, lower: [0.0, 0.0], upper: [0.32, 0.08], cells: [32, 8], patch_cells: [8, 8], gravity: [0.0, 0.0]}
   materials:
-    water:
-      kind: fluid
-      equation_of_state: {type: linear_water, bulk_modulus: 2.15e9, reference_density: 998.0, reference_pressure: 101325.0, reference_temperature: 293.15}
-      viscosity: 0.0
-      specific_heat: 4157.0
-  initial_state: {background_material: water, temperature: 293.15, pressure: 101325.0}
+)" + std::string(kInviscidWater) + R"(  initial_state: {background_material: water, temperature: 293.15, pressure: 101325.0}
   time: {end_time: 1.0e-4, dt_initial: 1.0e-4}
   output: {directory: unused, interval: 1.0}
   ice: {)") + filter + "}\n");

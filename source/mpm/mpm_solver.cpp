@@ -701,9 +701,13 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt)
       if (c >= 0) out(c, predictedVolumeColumn(nm, m)) += predicted.share[k] * Vp;
     }
     // Face shares: the particle's volume in the layers of width kFaceLayer cells just below and
-    // just above each interior face its box reaches, per volume of the layer.
+    // just above each interior face its box reaches, per volume of the layer. A rigid particle's
+    // where it will be at the end of the step (its motion is prescribed): a moving body opens a face
+    // that it leaves in the step in which it leaves it (IceSolver::faceVelocities), so that the room
+    // it leaves behind is reachable in the same step.
     for (int d = 0; d < Dim; ++d) {
-      const double lo = (xp[d] - lp[d] - origin[d]) / spacing[d], hi = (xp[d] + lp[d] - origin[d]) / spacing[d];
+      const double at = table.rigid[m] ? moved[d] : xp[d];
+      const double lo = (at - lp[d] - origin[d]) / spacing[d], hi = (at + lp[d] - origin[d]) / spacing[d];
       const double per_length = Vp / ((hi - lo) * kFaceLayer * cell_volume);
       const long long first_face = -(long long)math::floor(kFaceLayer - lo), last_face = (long long)math::floor(hi + kFaceLayer);
       for (long long f = first_face; f <= last_face; ++f) {

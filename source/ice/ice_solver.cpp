@@ -383,22 +383,13 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
               b += 0.5 * (fl[m] + fr[m]) * sv[m];
             }
             // A rigid body closes its larger share of the face; the other materials flow through
-            // the rest (a face inside it, or on its surface, is a wall). Its shares are those at the
-            // end of the step (MpmSolver::particlesToCells): a moving body that has left the face on
-            // the side it comes from by then opens the face entirely, and the fluid on that side
-            // follows it into the room it leaves in the cell ahead, drawn by the pressure equation.
-            // (Closed by its larger share, the face behind the top of a plunger moving down stayed a
-            // wall until the top was h/8 past it, the room had no way in, and the pressure of that
-            // cell stretched the body's equation of state: −2e4 Pa in the first step of 1e-5 s at
-            // 0.1 m/s, which pulled the air above in at ~100 m/s. Closed by its share on the side
-            // it comes from alone, the face opened up to h/8 before the top reached it, into a cell
-            // that the body still filled.) It keeps its own face velocity, no pressure correction.
+            // the rest (a face inside it, or on its surface, is a wall). A moving body's share is
+            // the time its box covers the face in the step (MpmSolver::particlesToCells), so the
+            // fluids cross what it opens (behind it) or what it has not closed yet (ahead of it) at
+            // its speed. It keeps its own face velocity and takes no pressure correction.
             double closed = 0;
             for (int m = 0; m < nm; ++m)
-              if (roles.rigid[m]) {
-                const double behind = vel[m] > 0.0 ? fl[m] : vel[m] < 0.0 ? fr[m] : 1.0;
-                closed += behind > 0.0 ? Kokkos::Experimental::fmax(fl[m], fr[m]) : 0.0;
-              }
+              if (roles.rigid[m]) closed += Kokkos::Experimental::fmax(fl[m], fr[m]);
             const double open = closed < 1.0 ? 1.0 - closed : 0.0;
             const double mixture = momentum / (weight + kTiny);
             for (int m = 0; m < nm; ++m) {

@@ -39,6 +39,7 @@ struct MaterialTable {
   int count = 0;
   int rigid[kMaxMaterials] = {};
   double rigid_velocity[kMaxMaterials][3] = {};
+  int rigid_moving[kMaxMaterials] = {};  // a rigid material with a velocity other than zero
 };
 
 MaterialTable materialTable(const std::vector<SolidMaterial>& materials)
@@ -48,7 +49,10 @@ MaterialTable materialTable(const std::vector<SolidMaterial>& materials)
   for (int m = 0; m < table.count; ++m)
     if (const Rigid* rigid = materials[m].model.getIf<Rigid>()) {
       table.rigid[m] = 1;
-      for (int d = 0; d < 3; ++d) table.rigid_velocity[m][d] = rigid->velocity(d);
+      for (int d = 0; d < 3; ++d) {
+        table.rigid_velocity[m][d] = rigid->velocity(d);
+        if (rigid->velocity(d) != 0.0) table.rigid_moving[m] = 1;
+      }
     }
   return table;
 }
@@ -701,13 +705,47 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt)
       if (c >= 0) out(c, predictedVolumeColumn(nm, m)) += predicted.share[k] * Vp;
     }
     // Face shares: the particle's volume in the layers of width kFaceLayer cells just below and
-    // just above each interior face its box reaches, per volume of the layer. A rigid particle's
-    // where it will be at the end of the step (its motion is prescribed): a moving body opens a face
-    // that it leaves in the step in which it leaves it (IceSolver::faceVelocities), so that the room
-    // it leaves behind is reachable in the same step.
+    // just above each interior face its box reaches, per volume of the layer. A moving rigid body's
+    // instead (both sides alike): the share of the face itself that its box covers, averaged over
+    // the step as the box moves by Δt v. The layers count a surface within h/8 of a face as a
+    // partial cover, which is wrong both ways for a prescribed motion: behind a body that leaves a
+    // face (the top of a plunger moving down) the face stayed closed until the body was h/8 past
+    // it, so the room it left had no way in; ahead of a body that comes at a face, the fluid
+    // between them had to leave through the layer's open part, ever faster as the gap closed.
+    // Averaged over the step, the open part is the time the face is open, and the fluid crosses it
+    // at the body's speed either way.
+    if (table.rigid[m] && table.rigid_moving[m]) {
+      for (int d = 0; d < Dim; ++d) {
+        const double lo = (xp[d] - lp[d] - origin[d]) / spacing[d], hi = (xp[d] + lp[d] - origin[d]) / spacing[d];
+        const double shift = dt * velocity[d] / spacing[d];  // the box's displacement in the step, in cells
+        const double per_cover = Vp / ((hi - lo) * cell_volume);  // share of a face per lateral share w
+        const long long first_face = (long long)math::floor(math::min(lo, lo + shift));
+        const long long last_face = (long long)math::floor(math::max(hi, hi + shift)) + 1;
+        for (long long f = first_face; f <= last_face; ++f) {
+          if (f < 1 || f > count[d] - 1) continue;  // domain faces are walls
+          // Share of the step during which lo + shift τ <= f <= hi + shift τ (τ in [0, 1]).
+          double time = 0;
+          if (shift == 0.0) {
+            time = lo <= f && f <= hi ? 1.0 : 0.0;
+          } else {
+            const double a = (f - hi) / shift, b = (f - lo) / shift;
+            time = math::max(0.0, math::min(1.0, math::max(a, b)) - math::max(0.0, math::min(a, b)));
+          }
+          if (time <= 0) continue;
+          overlap.acrossDirection(d, [&](long long ijk[3], double w) {
+            ijk[d] = f;
+            const LocalOrdinal c = cells(ijk[0], ijk[1], ijk[2]);
+            if (c < 0) return;
+            const int column = faceColumn(nm, m, d, 0);
+            out(c, column) += w * per_cover * time;
+            out(c, column + 1) += w * per_cover * time;
+          });
+        }
+      }
+      return;
+    }
     for (int d = 0; d < Dim; ++d) {
-      const double at = table.rigid[m] ? moved[d] : xp[d];
-      const double lo = (at - lp[d] - origin[d]) / spacing[d], hi = (at + lp[d] - origin[d]) / spacing[d];
+      const double lo = (xp[d] - lp[d] - origin[d]) / spacing[d], hi = (xp[d] + lp[d] - origin[d]) / spacing[d];
       const double per_length = Vp / ((hi - lo) * kFaceLayer * cell_volume);
       const long long first_face = -(long long)math::floor(kFaceLayer - lo), last_face = (long long)math::floor(hi + kFaceLayer);
       for (long long f = first_face; f <= last_face; ++f) {

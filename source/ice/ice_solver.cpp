@@ -792,7 +792,20 @@ void IceSolver<Dim>::filterOddEven(const CellState<Dim>& state)
   Kokkos::deep_copy(increment, 0.0);
   new_velocity_.exchangeHalo();
   for (int d = 0; d < Dim; ++d) {
-    // δ_d² u, with each face weighted by the ratio of the two cells' densities of the fluid.
+    // Whether the velocity zigzags across the face between c and its neighbour on `side`: the three
+    // differences of the four cells around it (c's other neighbour, c, o, o's other neighbour)
+    // alternate in sign. A smooth flow turns at most once in four cells, so it passes untouched.
+    const auto zigzag = KOKKOS_LAMBDA(const LocalOrdinal c, const int side, const int col)->bool
+    {
+      const LocalOrdinal o = neighbours(c, 2 * d + side);
+      if (o < 0) return false;
+      const LocalOrdinal before = neighbours(c, 2 * d + 1 - side), after = neighbours(o, 2 * d + side);
+      if (before < 0 || after < 0) return false;
+      const double d1 = un(c, col) - un(before, col), d2 = un(o, col) - un(c, col), d3 = un(after, col) - un(o, col);
+      return d1 * d2 < 0 && d2 * d3 < 0;
+    };
+    // The level δ² u per unit density: L_c = Σ_o m_co (u_o − u_c) / ρ_c over the zigzag faces, with
+    // m_co = min(ρ_c, ρ_o) the face's weight (the fluid's densities in the two cells).
     Kokkos::parallel_for(
         "ice::filterLaplacian", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
         KOKKOS_LAMBDA(const LocalOrdinal c) {
@@ -802,16 +815,21 @@ void IceSolver<Dim>::filterOddEven(const CellState<Dim>& state)
             double sum = 0;
             if (!roles.lagrangian[m] && !roles.rigid[m] && rc > 0)
               for (int side = 0; side < 2; ++side) {
+                if (!zigzag(c, side, col)) continue;
                 const LocalOrdinal o = neighbours(c, 2 * d + side);
-                if (o < 0) continue;
-                const double ro = rho(o, m);
-                sum += Kokkos::Experimental::fmin(rc, ro) / Kokkos::Experimental::fmax(rc, ro) * (un(o, col) - un(c, col));
+                sum += Kokkos::Experimental::fmin(rc, rho(o, m)) * (un(o, col) - un(c, col));
               }
-            laplacian(c, col) = sum;
+            laplacian(c, col) = rc > 0 ? sum / rc : 0.0;
           }
         });
     filter_laplacian_.exchangeHalo();
-    // −κ δ_d⁴ u as momentum fluxes of δ_d² u between neighbours.
+    // −κ δ_d⁴ u as momentum fluxes of the level between neighbours across the same faces:
+    // ρ_c Δu_c = −κ Σ_o m_co (L_o − L_c). In matrix form ρ Δu = −κ B ρ⁻¹ B u with B the weighted
+    // graph Laplacian of the zigzag faces (symmetric, positive semi-definite, rows summing to
+    // zero), so the filter conserves momentum and never adds kinetic energy:
+    // Σ ρ u·Δu = −κ |ρ^(−1/2) B u|² ≤ 0, whatever the densities and the faces chosen. (A level
+    // over every face weighted by the densities' ratio, as first written, made the operator
+    // unsymmetric where the fluid's density jumps, at a sand front, with no such bound.)
     Kokkos::parallel_for(
         "ice::filterFlux", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
         KOKKOS_LAMBDA(const LocalOrdinal c) {
@@ -821,15 +839,8 @@ void IceSolver<Dim>::filterOddEven(const CellState<Dim>& state)
             if (roles.lagrangian[m] || roles.rigid[m] || !(rc > 0)) continue;
             double flux = 0;
             for (int side = 0; side < 2; ++side) {
+              if (!zigzag(c, side, col)) continue;
               const LocalOrdinal o = neighbours(c, 2 * d + side);
-              if (o < 0) continue;
-              // Only where the velocity zigzags across the face: the three differences of the four
-              // cells around it (c's other neighbour, c, o, o's other neighbour) alternate in sign.
-              // A smooth flow turns at most once in four cells, so it passes untouched.
-              const LocalOrdinal before = neighbours(c, 2 * d + 1 - side), after = neighbours(o, 2 * d + side);
-              if (before < 0 || after < 0) continue;
-              const double d1 = un(c, col) - un(before, col), d2 = un(o, col) - un(c, col), d3 = un(after, col) - un(o, col);
-              if (!(d1 * d2 < 0 && d2 * d3 < 0)) continue;
               flux += Kokkos::Experimental::fmin(rc, rho(o, m)) * (laplacian(o, col) - laplacian(c, col));
             }
             increment(c, col) -= kappa * flux / rc;

@@ -1,7 +1,10 @@
-"""Checks a short run of the seed scene (Rzadkiewicz slide): every material's mass conserved (fluids
-to round-off, particles exactly), the sand's centre of mass lower than at the start, every value
-finite, and the kinetic energy of all materials no more than the potential energy that the sand's
-descent released (its buoyant weight times its drop: the energy budget allows nothing else)."""
+"""Checks a short run of a scene of sand in water (the seed scene, the Rzadkiewicz slide, or the sand
+column collapse): every material's mass conserved (fluids to round-off, particles exactly), the
+sand's centre of mass lower than at the start, every value finite, and the kinetic energy of all
+materials no more than the potential energy that the sand's descent released (its buoyant weight
+times its drop: the energy budget allows nothing else).
+
+usage: check_seed_scene.py OUTPUT_DIRECTORY [SAND_MATERIAL_INDEX (default 1: bed, sand, water, air)]"""
 import csv
 import glob
 import math
@@ -26,13 +29,14 @@ for fluid in ("water", "air"):
     m0, m1 = float(first["mass_" + fluid]), float(last["mass_" + fluid])
     # Advection conserves mass to round-off; 1e-12 relative allows the sums' rounding over the steps.
     check(abs(m1 - m0) <= 1e-12 * m0, "%s mass %.15g -> %.15g" % (fluid, m0, m1))
-for solid in ("bed", "sand"):
+solids = [k[len("mass_"):] for k in first if k.startswith("mass_") and k not in ("mass_water", "mass_air")]
+for solid in solids:
     check(first["mass_" + solid] == last["mass_" + solid], "%s particle mass unchanged (%s)" % (solid, last["mass_" + solid]))
 finite = all(math.isfinite(float(v)) for r in rows for k, v in r.items() if k != "dt_limiter")
 check(finite, "every CSV value finite")
 
 steps = sorted(glob.glob(out + "/*_[0-9]*.h5"))
-SAND = 1  # scene material index of the sand (bed, sand, water, air)
+SAND = int(sys.argv[2]) if len(sys.argv) > 2 else 1  # scene material index of the sand
 
 
 def sand_centre(path):

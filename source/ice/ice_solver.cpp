@@ -788,7 +788,7 @@ void IceSolver<Dim>::filterOddEven(const CellState<Dim>& state)
   const auto roles = roles_;
   auto un = new_velocity_.view();
   auto increment = filter_increment_.view();
-  const auto laplacian = filter_laplacian_.view();
+  auto laplacian = filter_laplacian_.view();
   Kokkos::deep_copy(increment, 0.0);
   new_velocity_.exchangeHalo();
   for (int d = 0; d < Dim; ++d) {
@@ -804,31 +804,36 @@ void IceSolver<Dim>::filterOddEven(const CellState<Dim>& state)
       const double d1 = un(c, col) - un(before, col), d2 = un(o, col) - un(c, col), d3 = un(after, col) - un(o, col);
       return d1 * d2 < 0 && d2 * d3 < 0;
     };
-    // The level δ² u per unit density: L_c = Σ_o m_co (u_o − u_c) / ρ_c over the zigzag faces, with
-    // m_co = min(ρ_c, ρ_o) the face's weight (the fluid's densities in the two cells).
+    // (B v)_c = Σ_o m_co (v_o − v_c) over the zigzag faces of c, with m_co = min(ρ_c, ρ_o) the
+    // face's weight (the fluid's densities in the two cells): B is the weighted graph Laplacian of
+    // those faces (symmetric, positive semi-definite, rows summing to zero).
+    const auto weightedDifference = KOKKOS_LAMBDA(const LocalOrdinal c, const int col, const double rc,
+                                                  const typename Field<Dim>::View& v)->double
+    {
+      double sum = 0;
+      for (int side = 0; side < 2; ++side) {
+        if (!zigzag(c, side, col)) continue;
+        const LocalOrdinal o = neighbours(c, 2 * d + side);
+        sum += Kokkos::Experimental::fmin(rc, rho(o, col / Dim)) * (v(o, col) - v(c, col));
+      }
+      return sum;
+    };
+    // The level δ² u per unit density, L = ρ⁻¹ B u.
     Kokkos::parallel_for(
         "ice::filterLaplacian", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
         KOKKOS_LAMBDA(const LocalOrdinal c) {
           for (int col = 0; col < columns; ++col) {
             const int m = col / Dim;
             const double rc = rho(c, m);
-            double sum = 0;
-            if (!roles.lagrangian[m] && !roles.rigid[m] && rc > 0)
-              for (int side = 0; side < 2; ++side) {
-                if (!zigzag(c, side, col)) continue;
-                const LocalOrdinal o = neighbours(c, 2 * d + side);
-                sum += Kokkos::Experimental::fmin(rc, rho(o, m)) * (un(o, col) - un(c, col));
-              }
-            laplacian(c, col) = rc > 0 ? sum / rc : 0.0;
+            const bool filtered = !roles.lagrangian[m] && !roles.rigid[m] && rc > 0;
+            laplacian(c, col) = filtered ? weightedDifference(c, col, rc, un) / rc : 0.0;
           }
         });
     filter_laplacian_.exchangeHalo();
     // −κ δ_d⁴ u as momentum fluxes of the level between neighbours across the same faces:
-    // ρ_c Δu_c = −κ Σ_o m_co (L_o − L_c). In matrix form ρ Δu = −κ B ρ⁻¹ B u with B the weighted
-    // graph Laplacian of the zigzag faces (symmetric, positive semi-definite, rows summing to
-    // zero), so the filter conserves momentum and never adds kinetic energy:
-    // Σ ρ u·Δu = −κ |ρ^(−1/2) B u|² ≤ 0, whatever the densities and the faces chosen. (A level
-    // over every face weighted by the densities' ratio, as first written, made the operator
+    // ρ Δu = −κ B L = −κ B ρ⁻¹ B u, so the filter conserves momentum and never adds kinetic
+    // energy: Σ ρ u·Δu = −κ |ρ^(−1/2) B u|² ≤ 0, whatever the densities and the faces chosen. (A
+    // level over every face weighted by the densities' ratio, as first written, made the operator
     // unsymmetric where the fluid's density jumps, at a sand front, with no such bound.)
     Kokkos::parallel_for(
         "ice::filterFlux", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
@@ -837,13 +842,7 @@ void IceSolver<Dim>::filterOddEven(const CellState<Dim>& state)
             const int m = col / Dim;
             const double rc = rho(c, m);
             if (roles.lagrangian[m] || roles.rigid[m] || !(rc > 0)) continue;
-            double flux = 0;
-            for (int side = 0; side < 2; ++side) {
-              if (!zigzag(c, side, col)) continue;
-              const LocalOrdinal o = neighbours(c, 2 * d + side);
-              flux += Kokkos::Experimental::fmin(rc, rho(o, m)) * (laplacian(o, col) - laplacian(c, col));
-            }
-            increment(c, col) -= kappa * flux / rc;
+            increment(c, col) -= kappa * weightedDifference(c, col, rc, laplacian) / rc;
           }
         });
   }

@@ -714,6 +714,18 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt)
     // between them had to leave through the layer's open part, ever faster as the gap closed.
     // Averaged over the step, the open part is the time the face is open, and the fluid crosses it
     // at the body's speed either way.
+    // Adds scale × (below, above) to the face columns of the cells at face f of direction d, in
+    // proportion to the particle's overlap w with each of them across d.
+    const auto addToFace = [&](int d, long long f, double scale, double below, double above) {
+      overlap.acrossDirection(d, [&](long long ijk[3], double w) {
+        ijk[d] = f;
+        const LocalOrdinal c = cells(ijk[0], ijk[1], ijk[2]);
+        if (c < 0) return;
+        const int column = faceColumn(nm, m, d, 0);
+        out(c, column) += w * scale * below;
+        out(c, column + 1) += w * scale * above;
+      });
+    };
     if (table.rigid[m] && table.rigid_moving[m]) {
       for (int d = 0; d < Dim; ++d) {
         const double lo = (xp[d] - lp[d] - origin[d]) / spacing[d], hi = (xp[d] + lp[d] - origin[d]) / spacing[d];
@@ -731,15 +743,7 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt)
             const double a = (f - hi) / shift, b = (f - lo) / shift;
             time = math::max(0.0, math::min(1.0, math::max(a, b)) - math::max(0.0, math::min(a, b)));
           }
-          if (time <= 0) continue;
-          overlap.acrossDirection(d, [&](long long ijk[3], double w) {
-            ijk[d] = f;
-            const LocalOrdinal c = cells(ijk[0], ijk[1], ijk[2]);
-            if (c < 0) return;
-            const int column = faceColumn(nm, m, d, 0);
-            out(c, column) += w * per_cover * time;
-            out(c, column + 1) += w * per_cover * time;
-          });
+          if (time > 0) addToFace(d, f, per_cover, time, time);
         }
       }
       return;
@@ -752,15 +756,7 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt)
         if (f < 1 || f > count[d] - 1) continue;  // domain faces are walls
         const double below = math::max(0.0, math::min(hi, double(f)) - math::max(lo, f - kFaceLayer));
         const double above = math::max(0.0, math::min(hi, f + kFaceLayer) - math::max(lo, double(f)));
-        if (below <= 0 && above <= 0) continue;
-        overlap.acrossDirection(d, [&](long long ijk[3], double w) {
-          ijk[d] = f;
-          const LocalOrdinal c = cells(ijk[0], ijk[1], ijk[2]);
-          if (c < 0) return;
-          const int column = faceColumn(nm, m, d, 0);
-          out(c, column) += w * per_length * below;
-          out(c, column + 1) += w * per_length * above;
-        });
+        if (below > 0 || above > 0) addToFace(d, f, per_length, below, above);
       }
     }
   };

@@ -49,6 +49,19 @@ inline void addLinearElastic(Scene& scene, const std::string& name, double densi
   scene.materials.push_back(MaterialSpec{name, "solid", list});
 }
 
+/// A rigid body at rest in a 2-D scene (2 particles per cell and direction).
+inline void addRigid(Scene& scene, const std::string& name, double density)
+{
+  Teuchos::ParameterList list;
+  list.set("kind", std::string("solid"));
+  list.set("density", density);
+  list.set("particles_per_cell", 2);
+  Teuchos::ParameterList& model = list.sublist("model");
+  model.set("type", std::string("rigid"));
+  model.set("velocity", Teuchos::Array<double>(2, 0.0));
+  scene.materials.push_back(MaterialSpec{name, "solid", list});
+}
+
 inline void addNeoHookean(Scene& scene, const std::string& name, double density, double bulk_modulus,
                           double shear_modulus, int particles_per_cell)
 {

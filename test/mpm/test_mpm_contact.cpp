@@ -19,23 +19,11 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kH = 0.01;         // cell size (m)
 constexpr double kPlateTop = 0.08;  // m
 
-void addRigid(Scene& scene, const std::string& name, double density)
-{
-  Teuchos::ParameterList list;
-  list.set("kind", std::string("solid"));
-  list.set("density", density);
-  list.set("particles_per_cell", 2);
-  Teuchos::ParameterList& model = list.sublist("model");
-  model.set("type", std::string("rigid"));
-  model.set("velocity", Teuchos::Array<double>(2, 0.0));
-  scene.materials.push_back(MaterialSpec{name, "solid", list});
-}
-
 /// A rigid plate 3 cells thick under an elastic block 10 x 5 cells whose bottom is `gap` above it.
 Scene plateScene(const std::array<double, 3>& gravity, double gap)
 {
   Scene scene = scenes::dryScene<2>({0, 0, 0}, {1.0, 0.2, 0}, {100, 20, 1}, {25, 20, 1}, gravity);
-  addRigid(scene, "plate", 2000.0);
+  scenes::addRigid(scene, "plate", 2000.0);
   scenes::addLinearElastic(scene, "block", 1000.0, 1.0e6, 0.3, 2);
   scenes::addBox(scene, "plate", {0.0, kPlateTop - 3 * kH, 0}, {1.0, kPlateTop, 0});
   scenes::addBox(scene, "block", {0.05, kPlateTop + gap, 0}, {0.15, kPlateTop + gap + 5 * kH, 0});

@@ -6,6 +6,7 @@
 // is 0.1 m x 0.05 m, 10 mm cells, 2 x 2 particles per cell, E = 1 MPa, nu = 0.3, rho = 1000 kg/m^3
 // (P-wave speed 36.7 m/s, shear 19.6 m/s; static strain 4e-4, so it is nearly rigid).
 #include "mpm/mpm_solver.hpp"
+#include "disk_scene.hpp"
 #include "mpm_scene_builder.hpp"
 
 #include <gtest/gtest.h>
@@ -71,24 +72,12 @@ Scene wallScene(double theta, int refine = 1)
   return scene;
 }
 
-void addRigid(Scene& scene, const std::string& name, double density)
-{
-  Teuchos::ParameterList list;
-  list.set("kind", std::string("solid"));
-  list.set("density", density);
-  list.set("particles_per_cell", 2);
-  Teuchos::ParameterList& model = list.sublist("model");
-  model.set("type", std::string("rigid"));
-  model.set("velocity", Teuchos::Array<double>(2, 0.0));
-  scene.materials.push_back(MaterialSpec{name, "solid", list});
-}
-
 /// A rigid particle plate 3 cells thick (material 0) under the block (material 1), whose bottom is
 /// `gap` above the plate (as test_mpm_contact).
 Scene plateScene(const std::array<double, 3>& gravity, double gap)
 {
   Scene scene = scenes::dryScene<2>({0, 0, 0}, {1.0, 0.2, 0}, {100, 20, 1}, {25, 20, 1}, gravity);
-  addRigid(scene, "plate", 2000.0);
+  scenes::addRigid(scene, "plate", 2000.0);
   scenes::addLinearElastic(scene, "block", kDensityBlock, kYoungBlock, kPoissonBlock, 2);
   scenes::addBox(scene, "plate", {0.0, kPlateTop - 3 * kH, 0}, {1.0, kPlateTop, 0});
   scenes::addBox(scene, "block", {0.05, kPlateTop + gap, 0}, {0.15, kPlateTop + gap + kBlockHeight, 0});
@@ -123,20 +112,24 @@ double elasticShearDisplacement(double theta)
 struct Rest {
   double drift, displacement;
 };
+Rest restOf(const Scene& scene, const MpmOptions& options, int material, double theta)
+{
+  MpmSolver<2> solver(scene, scenes::layoutFor<2>(scene, Tpetra::getDefaultComm()), options);
+  const double x0 = centreOf(solver, material).x[0], dt = solver.stableTimeStep().dt;
+  long long n = 0;
+  runTo(solver, dt, n, 0.5, tilted(theta), 0.2);
+  const double x_half = centreOf(solver, material).x[0];
+  runTo(solver, dt, n, 1.0, tilted(theta), 0.2);
+  const double x_end = centreOf(solver, material).x[0];
+  return {x_end - x_half, x_end - x0};
+}
+
 Rest restOnWall(double theta, double mu)
 {
-  const Scene scene = wallScene(theta);
   MpmOptions options;
   options.wall_friction = mu;
   options.cfl = 0.4;
-  MpmSolver<2> solver(scene, scenes::layoutFor<2>(scene, Tpetra::getDefaultComm()), options);
-  const double x0 = centreOf(solver, 0).x[0], dt = solver.stableTimeStep().dt;
-  long long n = 0;
-  runTo(solver, dt, n, 0.5, tilted(theta), 0.2);
-  const double x_half = centreOf(solver, 0).x[0];
-  runTo(solver, dt, n, 1.0, tilted(theta), 0.2);
-  const double x_end = centreOf(solver, 0).x[0];
-  return {x_end - x_half, x_end - x0};
+  return restOf(wallScene(theta), options, 0, theta);
 }
 
 /// Creep speed of the block released stress-free into full gravity (the state every test scene
@@ -193,23 +186,17 @@ TEST(FrictionAtRest, PlateHoldsBlockBelowFrictionAngle)
 {
   const double theta = 20 * kPi / 180, mu = 0.4;
   // The block set on the plate (gap 0: contact from the first step).
-  const Scene scene = plateScene(tilted(theta), 0.0);
   MpmOptions options;
   options.contact_friction = mu;
   options.cfl = 0.4;
-  MpmSolver<2> solver(scene, scenes::layoutFor<2>(scene, Tpetra::getDefaultComm()), options);
-  const double x0 = centreOf(solver, 1).x[0], dt = solver.stableTimeStep().dt;
-  long long n = 0;
-  runTo(solver, dt, n, 0.5, tilted(theta), 0.2);
-  const double x_half = centreOf(solver, 1).x[0];
-  runTo(solver, dt, n, 1.0, tilted(theta), 0.2);
-  const double x_end = centreOf(solver, 1).x[0], u = elasticShearDisplacement(theta);
+  const Rest rest = restOf(plateScene(tilted(theta), 0.0), options, 1, theta);
+  const double u = elasticShearDisplacement(theta);
   if (rankZero())
     std::printf("[ at rest  ] plate, 20 deg, mu 0.4, gravity ramped: displacement %.3e m at 1 s, drift 0.5 .. 1 s "
                 "%+.3e m\n",
-                x_end - x0, x_end - x_half);
-  EXPECT_LT(std::abs(x_end - x_half), 0.01 * u);  // as on the wall
-  EXPECT_LT(std::abs(x_end - x0), 2 * u);
+                rest.displacement, rest.drift);
+  EXPECT_LT(std::abs(rest.drift), 0.01 * u);  // as on the wall
+  EXPECT_LT(std::abs(rest.displacement), 2 * u);
 }
 
 // (g) Sliding above the friction angle: a = g (sin theta - mu cos theta), released stress-free.
@@ -320,39 +307,12 @@ TEST(MuslContact, BlockSlidesOnPlateAsCoulomb)
 // own material, frictionless contact on, MUSL, pure FLIP.
 namespace {
 
-constexpr double kYoung = 1000.0, kPoisson = 0.3, kDensity = 1000.0, kSpeed = 0.1, kRadius = 0.2;
-constexpr double kBulk = kYoung / (3 * (1 - 2 * kPoisson)), kShear = kYoung / (2 * (1 + kPoisson));
+using namespace cfdmpm::mpm::scenes::disks;
 
-void addDisk(Scene& scene, const std::string& material, double cx, double cy, double v)
-{
-  RegionSpec disk;
-  disk.name = "disk_" + std::to_string(scene.regions.size());
-  disk.material = material;
-  disk.shape = "polygon";
-  for (int k = 0; k < 128; ++k) {
-    const double a = 2 * kPi * k / 128;
-    disk.vertices.push_back({cx + kRadius * std::cos(a), cy + kRadius * std::sin(a)});
-  }
-  disk.velocity = {v, v, 0};
-  disk.temperature = 293.15;
-  scene.regions.push_back(disk);
-}
-
-/// Neo-Hookean stored energy sum V_p0 W(F_p) in plane strain (as test_mpm_disks), over all ranks.
+/// The stored energy of all ranks' particles.
 double storedEnergy(const MpmSolver<2>& solver)
 {
-  const auto& particles = solver.particles();
-  auto F = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), particles.deformation_gradient);
-  auto V0 = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), particles.initial_volume);
-  double local = 0, total = 0;
-  for (int p = 0; p < particles.count; ++p) {
-    const double J = F(p, 0, 0) * F(p, 1, 1) - F(p, 0, 1) * F(p, 1, 0);
-    double trace_b = 1.0;
-    for (int d = 0; d < 2; ++d)
-      for (int e = 0; e < 2; ++e) trace_b += F(p, d, e) * F(p, d, e);
-    local += V0(p) * (0.5 * kBulk * (0.5 * (J * J - 1) - std::log(J)) +
-                      0.5 * kShear * (std::pow(J, -2.0 / 3.0) * trace_b - 3));
-  }
+  double local = scenes::disks::storedEnergy(solver.particles()), total = 0;
   Teuchos::reduceAll(*solver.layout().comm(), Teuchos::REDUCE_SUM, local, Teuchos::outArg(total));
   return total;
 }

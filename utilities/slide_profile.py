@@ -94,9 +94,9 @@ def main():
     parser.add_argument("--densities", type=float, nargs=2, default=(1985.0, 999.8), metavar=("SAND", "WATER"))
     args = parser.parse_args()
     runs = profile(args.directory, args)
-    print("%7s %9s %8s %9s %8s %8s %8s %8s %9s %9s %9s %6s" % (
+    print("%7s %9s %8s %9s %8s %8s %8s %8s %9s %9s %9s" % (
         "time", "trough_m", "at_x", "crest_m", "at_x", "front_x", "centre_x", "centre_y", "kinetic", "released",
-        "kin/rel", ""))
+        "kin/rel"))
     for r in runs:
         kinetic = sum(r["kinetic"].values()) if r["kinetic"] else float("nan")
         ratio = kinetic / r["released"] if r["released"] > 0 else float("nan")

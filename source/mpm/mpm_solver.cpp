@@ -255,9 +255,10 @@ void MpmSolver<Dim>::allocateNodeFields()
   node_sums_ = std::make_unique<Field<Dim>>(layout_, Location::Node, columns.count(gradients), "mpm node sums");
   node_velocity_ = std::make_unique<Field<Dim>>(layout_, Location::Node, nm * Dim, "mpm node velocity");
   node_velocity_star_ = std::make_unique<Field<Dim>>(layout_, Location::Node, nm * Dim, "mpm node velocity star");
-  node_constraint_ = std::make_unique<Field<Dim>>(layout_, Location::Node, nm, "mpm node constraint");
-  if (options_.stress_update == StressUpdate::ModifiedLast)
+  if (options_.stress_update == StressUpdate::ModifiedLast) {
     node_velocity_new_ = std::make_unique<Field<Dim>>(layout_, Location::Node, nm * Dim, "mpm node velocity new");
+    node_constraint_ = std::make_unique<Field<Dim>>(layout_, Location::Node, nm, "mpm node constraint");
+  }
 }
 
 template <int Dim>
@@ -411,7 +412,9 @@ void MpmSolver<Dim>::integrateGrid(double dt)
   const auto sums = node_sums_->view();
   auto velocity = node_velocity_->view();
   auto velocity_star = node_velocity_star_->view();
-  auto constraint = node_constraint_->view();
+  // Only the MUSL re-map reads how v* was held.
+  const bool record = node_constraint_ != nullptr;
+  auto constraint = record ? node_constraint_->view() : typename Field<Dim>::View();
 
   Kokkos::parallel_for(
       "mpm::integrate_grid", Kokkos::RangePolicy<ExecutionSpace>(0, node_sums_->overlapCount()),
@@ -433,7 +436,7 @@ void MpmSolver<Dim>::integrateGrid(double dt)
         int kind[kMaxMaterials];
         conditions.apply(i, sums, m, vs, kind);
         for (int a = 0; a < nm; ++a) {
-          constraint(i, a) = kind[a];
+          if (record) constraint(i, a) = kind[a];
           for (int d = 0; d < Dim; ++d) {
             velocity(i, a * Dim + d) = v[a][d];
             velocity_star(i, a * Dim + d) = vs[a][d];
@@ -879,7 +882,8 @@ void MpmSolver<Dim>::addCellVelocityChangeWith(const Field<Dim>& change)
   const GridConditions<Dim> conditions = gridConditions<Dim>(*layout_, materials_, options_, empty_node_mass_, wall_no_slip_);
   const auto sums = node_sums_->view();
   auto velocity_star = node_velocity_star_->view();
-  auto constraint = node_constraint_->view();
+  const bool record = node_constraint_ != nullptr;  // only the MUSL re-map reads it
+  auto constraint = record ? node_constraint_->view() : typename Field<Dim>::View();
   const double empty = empty_node_mass_;
   Kokkos::parallel_for(
       "mpm::add_cell_velocity_change", Kokkos::RangePolicy<ExecutionSpace>(0, node_sums_->overlapCount()),
@@ -897,7 +901,7 @@ void MpmSolver<Dim>::addCellVelocityChangeWith(const Field<Dim>& change)
         // A material held by the first pass (integrateGrid) has no approach left to remove unless
         // the change pushes it in again, so it counts as held if either pass held it.
         for (int a = 0; a < nm; ++a) {
-          constraint(i, a) = math::max(constraint(i, a), double(kind[a]));
+          if (record) constraint(i, a) = math::max(constraint(i, a), double(kind[a]));
           for (int d = 0; d < Dim; ++d) velocity_star(i, a * Dim + d) = vs[a][d];
         }
       });

@@ -237,7 +237,7 @@ class MpmSolver {
   std::unique_ptr<Field<Dim>> node_velocity_;       // v = p / m
   std::unique_ptr<Field<Dim>> node_velocity_star_;  // v* after forces, contact and walls
   std::unique_ptr<Field<Dim>> node_velocity_new_;   // MUSL: updated particle momenta mapped back
-  std::unique_ptr<Field<Dim>> node_constraint_;     // per material: how v* was held (ConstraintKind)
+  std::unique_ptr<Field<Dim>> node_constraint_;     // MUSL: per material, how v* was held (ConstraintKind)
   std::unique_ptr<Field<Dim>> node_momentum_change_;  // coupled step: Σ_p w_ip m_p Δv_p
   // With more than one thread, the particle-to-node scatters run tile colour by tile colour
   // (ParticleBins); the bins of P2G hold until G2P moves the particles.

@@ -23,7 +23,7 @@ struct SweepRow {
 
 /// Writes rows as <directory>/<name>_np<ranks>.csv on rank 0: the directory is $CFDMPM_STABILITY_DIR when set,
 /// else the working directory (ctest's: build/test/stability). The header names the columns, and a
-/// comment line before it names the quantities.
+/// comment line before it names the quantities. The method is quoted (it may hold commas).
 inline void writeSweep(const Teuchos::Comm<int>& comm, const std::string& name, const std::string& parameter,
                        const std::string& value, const std::vector<SweepRow>& rows,
                        const std::vector<std::pair<std::string, double>>& thresholds = {})
@@ -37,7 +37,7 @@ inline void writeSweep(const Teuchos::Comm<int>& comm, const std::string& name, 
   for (const auto& [label, at] : thresholds) out << "# threshold " << label << " = " << std::setprecision(6) << at << "\n";
   out << "parameter,value,method,status\n";
   out << std::setprecision(10);
-  for (const SweepRow& r : rows) out << r.parameter << "," << r.value << "," << r.method << "," << r.status << "\n";
+  for (const SweepRow& r : rows) out << r.parameter << "," << r.value << ",\"" << r.method << "\"," << r.status << "\n";
   std::cout << "stability: wrote " << path << " (" << rows.size() << " rows)\n";
 }
 

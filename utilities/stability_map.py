@@ -31,7 +31,7 @@ PANELS = [
      "acoustic Courant number c Δt / h", "largest |u| in 400 steps / slug speed", True, True,
      [(10.0, "failure bound (10x)")]),
     ("stability_c_drag", "(c) stiff drag, Δt = 1e-4 s",
-     "exchange coefficient K (kg/(m³ s))", "|w'/w| after one step (relative velocity)", True, True,
+     "exchange coefficient K (kg/(m³ s))", "relative velocity after one step / before", True, True,
      [(1.0, "|w'/w| = 1: growth above")]),
     ("stability_d_still_surface", "(d) still surface under a gas",
      "density ratio liquid / gas", "largest speed in 1 s (m/s)", True, True,

@@ -156,7 +156,7 @@ double relativeDifference(const std::vector<double>& a, const std::vector<double
 TEST(IceScenes, AcousticPulseImplicitStaysBoundedWhereExplicitBlowsUp)
 {
   const double c = std::sqrt(2.15e9 / 998.0);  // water's sound speed, 1468 m/s
-  const double dt_acoustic = 0.005 / c;        // explicit limit: one cell per step
+  const double dt_acoustic = 0.005 / c;        // one cell per step (the explicit limit is ~0.57 of it: doc/stability.md, a)
   const double end_time = 100 * 100 * dt_acoustic;
   for (double factor : {10.0, 100.0}) {
     const AcousticOutcome implicit = runAcoustic("implicit", factor * dt_acoustic, end_time);

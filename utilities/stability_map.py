@@ -58,7 +58,7 @@ PANELS = [
      "cell size (mm)", "speed along the incline at rest (m/s)", False, True,
      [(0.01 * 1.09e-5 / 0.5, "bound: 1 % of the elastic shear in 0.5 s")]),
     ("stability_h_touch", "(h) two disks, MUSL, frictionless contact",
-     "cells across the unit square", "energy lost / gained (fraction)", True, False,
+     "cells across the unit square", "energy lost / gained (fraction)", False, False,
      [(0.01, "gain bound 1 %")]),
 ]
 

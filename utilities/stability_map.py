@@ -52,7 +52,7 @@ PANELS = [
     ("stability_mpm_flip", "(f) PIC/FLIP blend: bar, 1000 steps, MUSL",
      "FLIP fraction (1 = pure FLIP, 0 = PIC)", "energy lost / initial; noise / v0", False, True, []),
     ("stability_mpm_ppc", "(f) particles per cell: bar period, 32 cells",
-     "particles per cell and direction", "|period / (2L/c) - 1|", False, True,
+     "particles per cell and direction", "|period / (2L/c) - 1|; column RMS σ_yy error / (ρ g H)", False, True,
      [(0.01, "bound 1 %"), (4.0e-4, "lumped-mass dispersion (π/32)²/24")]),
     (("stability_g_rest", "stability_g_release"), "(g) block on a 20° incline, μ = 0.4",
      "cell size (mm)", "speed along the incline at rest (m/s)", False, True,

@@ -6,11 +6,12 @@ value, method, status; comment lines "# threshold <label> = <value>") and draws,
 swept parameter on x, the error or growth factor on y, the weak method and cfdmpm's on the same
 axes, failed runs as crosses and the failure thresholds as vertical lines.
 
-usage: utilities/stability_map.py [--dir DIR] [--ranks N] [--out PNG]
+usage: utilities/stability_map.py [--dir DIR]... [--ranks N] [--out PNG]
 
-DIR defaults to build/test/stability (where ctest runs them; or the directory given to the tests
-in $CFDMPM_STABILITY_DIR); N picks the rank count whose CSVs are drawn (default 1); PNG defaults to
-doc/stability-map.png. Prints the thresholds it found.
+DIR (repeatable) defaults to build/test/stability and build/test/mpm (where ctest runs the fluid
+cases and the MPM cases (f)-(h); or the directory given to the tests in $CFDMPM_STABILITY_DIR); N
+picks the rank count whose CSVs are drawn (default 1); PNG defaults to doc/stability-map.png.
+Prints the thresholds it found.
 """
 import argparse
 import csv
@@ -25,7 +26,8 @@ import matplotlib.ticker  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
-# (file stem, panel title, x label, y label, x log, y log, horizontal reference lines (y, label))
+# (file stem or tuple of stems, panel title, x label, y label, x log, y log, horizontal reference
+# lines (y, label)). A method is drawn solid when its name contains "cfdmpm", dashed otherwise.
 PANELS = [
     ("stability_a_pressure", "(a) pressure: explicit vs implicit",
      "acoustic Courant number c Δt / h", "largest |u| in 400 steps / slug speed", True, True,
@@ -42,6 +44,22 @@ PANELS = [
     ("stability_e_vanishing", "(e) vanishing water: slug in an air channel",
      "slug speed (m/s)", "relative mass change; smallest θ_water", False, True,
      [(1e-12, "θ = 1e-12; mass bound 1e-12")]),
+    ("stability_mpm_crossing", "(f) cell crossing: column under its weight",
+     "cells over the column's height", "RMS σ_yy error / (ρ g H)", True, True,
+     [(0.02, "GIMP bound at 32 cells")]),
+    ("stability_mpm_drift", "(f) USL vs MUSL: bar, 1000 steps, pure FLIP",
+     "Courant number", "|energy change| / initial", False, True, []),
+    ("stability_mpm_flip", "(f) PIC/FLIP blend: bar, 1000 steps, MUSL",
+     "FLIP fraction (1 = pure FLIP, 0 = PIC)", "energy lost / initial; noise / v0", False, True, []),
+    ("stability_mpm_ppc", "(f) particles per cell: bar period, 32 cells",
+     "particles per cell and direction", "|period / (2L/c) - 1|; column RMS σ_yy error / (ρ g H)", False, True,
+     [(0.01, "bound 1 %"), (4.0e-4, "lumped-mass dispersion (π/32)²/24")]),
+    (("stability_g_rest", "stability_g_release"), "(g) block on a 20° incline, μ = 0.4",
+     "cell size (mm)", "speed along the incline at rest (m/s)", False, True,
+     [(0.01 * 1.09e-5 / 0.5, "bound: 1 % of the elastic shear in 0.5 s")]),
+    ("stability_h_touch", "(h) two disks, MUSL, frictionless contact",
+     "cells across the unit square", "energy lost / gained (fraction)", False, False,
+     [(0.01, "gain bound 1 %")]),
 ]
 
 
@@ -58,26 +76,34 @@ def read_sweep(path):
     return rows, thresholds
 
 
-def sweeps_for(directory, stem, ranks):
-    """The CSVs of one panel: the stem itself, or every file starting with it (drag: cell + scene)."""
+def sweeps_for(directories, stems, ranks):
+    """The CSVs of one panel: every file starting with one of its stems (drag: cell + scene), in
+    any of the directories."""
     suffix = "_np%d.csv" % ranks
-    found = sorted(n for n in os.listdir(directory) if n.startswith(stem) and n.endswith(suffix))
-    return [os.path.join(directory, n) for n in found]
+    stems = (stems,) if isinstance(stems, str) else stems
+    found = []
+    for directory in directories:
+        if os.path.isdir(directory):
+            found += sorted(os.path.join(directory, n) for n in os.listdir(directory)
+                            if n.startswith(stems) and n.endswith(suffix))
+    return found
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--dir", default=os.path.join(ROOT, "build", "test", "stability"))
+    parser.add_argument("--dir", action="append",
+                        help="directory of the CSVs (repeatable; default build/test/stability and build/test/mpm)")
     parser.add_argument("--ranks", type=int, default=1)
     parser.add_argument("--out", default=os.path.join(ROOT, "doc", "stability-map.png"))
     args = parser.parse_args()
-    if not os.path.isdir(args.dir):
-        sys.exit("stability_map.py: no directory %s (run `ctest -L stability` first)" % args.dir)
+    dirs = args.dir or [os.path.join(ROOT, "build", "test", d) for d in ("stability", "mpm")]
+    if not any(os.path.isdir(d) for d in dirs):
+        sys.exit("stability_map.py: none of %s exists (run `ctest -L stability` first)" % ", ".join(dirs))
 
-    panels = [(p, sweeps_for(args.dir, p[0], args.ranks)) for p in PANELS]
+    panels = [(p, sweeps_for(dirs, p[0], args.ranks)) for p in PANELS]
     panels = [(p, files) for p, files in panels if files]
     if not panels:
-        sys.exit("stability_map.py: no stability_*_np%d.csv in %s" % (args.ranks, args.dir))
+        sys.exit("stability_map.py: no stability_*_np%d.csv in %s" % (args.ranks, ", ".join(dirs)))
     columns = 3
     rows_n = (len(panels) + columns - 1) // columns
     fig, axes = plt.subplots(rows_n, columns, figsize=(5.2 * columns, 4.2 * rows_n), squeeze=False)
@@ -92,10 +118,14 @@ def main():
                 methods.setdefault(method, []).append((x, y, status))
         for i, (method, points) in enumerate(methods.items()):
             points.sort()
+            if ylog:  # a zero (no energy gained, no drift) has no place on a log axis
+                points = [p for p in points if p[1] > 0]
+                if not points:
+                    continue
             colour = colours[i % len(colours)]
             weak = "cfdmpm" not in method and "mass change" not in method
             xs = [p[0] for p in points]
-            ys = [max(p[1], 1e-300) if ylog else p[1] for p in points]
+            ys = [p[1] for p in points]
             ax.plot(xs, ys, "-" if not weak else "--", color=colour, lw=1.2,
                     label=method + (" (weak)" if weak and "smallest" not in method else ""))
             ok = [(x, y) for (x, _, s), y in zip(points, ys) if s == "ok"]
@@ -130,7 +160,7 @@ def main():
                  "vertical lines the measured thresholds", fontsize=10)
     fig.tight_layout(rect=(0, 0, 1, 0.96))
     fig.savefig(args.out, dpi=110)
-    print("stability_map.py: wrote %s (%d panels from %s)" % (args.out, len(panels), args.dir))
+    print("stability_map.py: wrote %s (%d panels from %s)" % (args.out, len(panels), ", ".join(dirs)))
 
 
 if __name__ == "__main__":

@@ -5,7 +5,11 @@
 // g (sin theta, -cos theta), so the floor (the y- wall, or a rigid plate) is the incline. The block
 // is 0.1 m x 0.05 m, 10 mm cells, 2 x 2 particles per cell, E = 1 MPa, nu = 0.3, rho = 1000 kg/m^3
 // (P-wave speed 36.7 m/s, shear 19.6 m/s; static strain 4e-4, so it is nearly rigid).
+//
+// Each case writes its numbers as stability_<g|h>_<case>_np<ranks>.csv (test/stability's
+// writeSweep: parameter, value, method, status) for utilities/stability_map.py.
 #include "mpm/mpm_solver.hpp"
+#include "../stability/stability_support.hpp"
 #include "disk_scene.hpp"
 #include "mpm_scene_builder.hpp"
 
@@ -175,6 +179,10 @@ TEST(FrictionAtRest, WallHoldsBlockBelowFrictionAngle)
     std::printf("[ at rest  ] wall, 20 deg, mu 0.4, gravity ramped: displacement %.3e m at 1 s (elastic shear scale "
                 "%.3e m), drift 0.5 .. 1 s %+.3e m\n",
                 rest.displacement, u, rest.drift);
+  // The drift as a speed over 0.5 .. 1 s, at the cell size (mm), beside the stress-free release's creep.
+  test::writeSweep(*Tpetra::getDefaultComm(), "stability_g_rest_wall", "cell size (mm)",
+                   "speed along the incline at rest (m/s)",
+                   {{kH * 1e3, std::abs(rest.drift) / 0.5, "cfdmpm: gravity ramped, wall", "ok"}});
   // Stuck: after 0.5 s only the elastic settling remains. Drift bound: 1 % of the elastic shear
   // displacement in 0.5 s (2e-7 m/s; released stress-free, the block creeps at 2.7e-2 m/s).
   EXPECT_LT(std::abs(rest.drift), 0.01 * u);
@@ -195,6 +203,9 @@ TEST(FrictionAtRest, PlateHoldsBlockBelowFrictionAngle)
     std::printf("[ at rest  ] plate, 20 deg, mu 0.4, gravity ramped: displacement %.3e m at 1 s, drift 0.5 .. 1 s "
                 "%+.3e m\n",
                 rest.displacement, rest.drift);
+  test::writeSweep(*Tpetra::getDefaultComm(), "stability_g_rest_plate", "cell size (mm)",
+                   "speed along the incline at rest (m/s)",
+                   {{kH * 1e3, std::abs(rest.drift) / 0.5, "cfdmpm: gravity ramped, plate", "ok"}});
   EXPECT_LT(std::abs(rest.drift), 0.01 * u);  // as on the wall
   EXPECT_LT(std::abs(rest.displacement), 2 * u);
 }
@@ -203,6 +214,7 @@ TEST(FrictionAtRest, PlateHoldsBlockBelowFrictionAngle)
 TEST(FrictionSliding, FollowsCoulombOnWallAndOnPlate)
 {
   const double theta = 30 * kPi / 180;
+  std::vector<test::SweepRow> rows;
   {
     const double mu = 0.4, a = kG * (std::sin(theta) - mu * std::cos(theta));  // 1.507 m/s^2
     const Scene scene = wallScene(theta);
@@ -211,7 +223,9 @@ TEST(FrictionSliding, FollowsCoulombOnWallAndOnPlate)
     options.cfl = 0.4;
     MpmSolver<2> solver(scene, scenes::layoutFor<2>(scene, Tpetra::getDefaultComm()), options);
     // 2 %, test_mpm_sliding's bound (settling of the stress-free block onto the floor).
-    EXPECT_LT(slideError(solver, 0, a, "wall, 30 deg, mu 0.4"), 0.02);
+    const double error = slideError(solver, 0, a, "wall, 30 deg, mu 0.4");
+    rows.push_back({1, error, "wall, mu 0.4", error < 0.02 ? "ok" : "failed"});
+    EXPECT_LT(error, 0.02);
   }
   {
     // Set on the plate (gap 0). With each material's own mass gradient as its contact normal,
@@ -222,8 +236,12 @@ TEST(FrictionSliding, FollowsCoulombOnWallAndOnPlate)
     options.contact_friction = mu;
     options.cfl = 0.4;
     MpmSolver<2> solver(scene, scenes::layoutFor<2>(scene, Tpetra::getDefaultComm()), options);
-    EXPECT_LT(slideError(solver, 1, a, "plate, 30 deg, mu 0.2"), 0.02);
+    const double error = slideError(solver, 1, a, "plate, 30 deg, mu 0.2");
+    rows.push_back({2, error, "plate, mu 0.2", error < 0.02 ? "ok" : "failed"});
+    EXPECT_LT(error, 0.02);
   }
+  test::writeSweep(*Tpetra::getDefaultComm(), "stability_g_sliding", "surface (1 wall, 2 rigid plate)",
+                   "largest |travelled / (a t^2/2) - 1| at 0.2-0.4 s", rows);
 }
 
 // (g) What makes a body "at rest" creep: released stress-free into full gravity it is not at rest
@@ -247,6 +265,11 @@ TEST(FrictionAtRest, StressFreeReleaseCreepsAlikeOnWallPlateAndFinerGrid)
   if (rankZero())
     std::printf("[ creep    ] released stress-free, 20 deg, mu 0.4: wall %.4f m/s, wall at h/2 %.4f m/s, plate %.4f m/s\n",
                 v_wall, v_fine, v_plate);
+  test::writeSweep(*Tpetra::getDefaultComm(), "stability_g_release", "cell size (mm)",
+                   "speed along the incline at rest (m/s)",
+                   {{kH * 1e3, v_wall, "released stress-free, wall", "failed"},
+                    {kH * 1e3 / 2, v_fine, "released stress-free, wall", "failed"},
+                    {kH * 1e3, v_plate, "released stress-free, plate", "failed"}});
   // It creeps: faster than 1 cm/s, against 2e-7 m/s loaded gradually.
   EXPECT_GT(v_wall, 0.01);
   // Within 10 % of each other: the spread of this speed over CFL 0.4 / 0.2 / 0.1 is 6 %.
@@ -285,6 +308,10 @@ TEST(MuslContact, DroppedBlockDoesNotReboundFasterThanItHit)
     EXPECT_GT(up, 0.5 * down);
     EXPECT_GT(lowest, kPlateTop);
   }
+  test::writeSweep(*Tpetra::getDefaultComm(), "stability_h_drop", "stress update (0 USL, 1 MUSL)",
+                   "rebound / impact speed of the centre of mass",
+                   {{0, ratio[0], "USL", ratio[0] < 1 ? "ok" : "failed"},
+                    {1, ratio[1], "cfdmpm: MUSL, contact held on v*", ratio[1] < 1 ? "ok" : "failed"}});
   // MUSL and USL differ in the strain rate only; their bounces agree to 5 % (0.884 and 0.882).
   EXPECT_NEAR(ratio[1], ratio[0], 0.05 * ratio[0]);
 }
@@ -300,7 +327,11 @@ TEST(MuslContact, BlockSlidesOnPlateAsCoulomb)
   options.contact_friction = mu;
   options.stress_update = StressUpdate::ModifiedLast;
   MpmSolver<2> solver(scene, scenes::layoutFor<2>(scene, Tpetra::getDefaultComm()), options);
-  EXPECT_LT(slideError(solver, 1, a, "MUSL, plate, 30 deg, mu 0.2"), 0.03);  // test_mpm_contact's USL bound
+  const double error = slideError(solver, 1, a, "MUSL, plate, 30 deg, mu 0.2");
+  test::writeSweep(*Tpetra::getDefaultComm(), "stability_h_slide", "stress update (1 MUSL)",
+                   "largest |travelled / (a t^2/2) - 1| at 0.2-0.4 s",
+                   {{1, error, "cfdmpm: MUSL, plate, mu 0.2", error < 0.03 ? "ok" : "failed"}});
+  EXPECT_LT(error, 0.03);  // test_mpm_contact's USL bound
 }
 
 // (h) The energy two elastic materials lose when they touch: the disks of test_mpm_disks, each its
@@ -361,6 +392,16 @@ TEST(ContactEnergy, LossAtTouchFallsWithTheCellSize)
   if (rankZero())
     std::printf("[ touch    ] losses %.4f, %.4f, %.4f at 20, 40, 80 cells: observed order %.2f\n", loss[0], loss[1],
                 loss[2], order);
+  std::vector<test::SweepRow> rows;
+  const double cells[3] = {20, 40, 80};
+  const Touch touches[3] = {coarse, medium, fine};
+  for (int k = 0; k < 3; ++k) {
+    rows.push_back({cells[k], loss[k], "cfdmpm: MUSL contact, energy lost", "ok"});
+    rows.push_back({cells[k], std::max(touches[k].highest - 1, 0.0), "cfdmpm: energy gained above the initial",
+                    touches[k].highest < 1.01 ? "ok" : "failed"});
+  }
+  test::writeSweep(*Tpetra::getDefaultComm(), "stability_h_touch", "cells across the unit square",
+                   "total energy lost (lowest over 3 s) / gained, fractions of the initial", rows);
   // No energy gained: MUSL without contact stays within 1 % above (test_mpm_disks, 20 x 20).
   for (const Touch& t : {coarse, medium, fine}) EXPECT_LT(t.highest, 1.01);
   // The loss falls at every refinement and at least at first order over the two halvings

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cfloat>
 #include <cmath>
 #include <limits>
@@ -334,13 +335,28 @@ struct DragSceneOutcome {
   std::string failure;
 };
 
+// The force of the walls of a square box of n x n cells of size h on what it holds, per unit depth,
+// from the pressure of the cells along them (p − kPressure: a uniform pressure pushes both walls of
+// a pair alike), summed over the ranks: x and y components.
+std::array<double, 2> wallPressureForce(const CoupledRun<2>& run, double h, long long n)
+{
+  const auto ijk = run.layout->cellIndex();
+  const auto p = run.state.pressure.view();
+  double local[2] = {0, 0};
+  for (LocalOrdinal c = 0; c < run.layout->ownedCells(); ++c)
+    for (int d = 0; d < 2; ++d) {
+      if (ijk(c, d) == 0) local[d] += (p(c, 0) - kPressure) * h;
+      if (ijk(c, d) == n - 1) local[d] -= (p(c, 0) - kPressure) * h;
+    }
+  return {globalSum(*world(), local[0]), globalSum(*world(), local[1])};
+}
+
 DragSceneOutcome runDragScene(double K, int steps)
 {
   const double beta = DragCell().beta(K, kDragDt);
   CoupledRun<2> run(sceneFromYaml(dragScene(K)), world());
   const double air_speed = 0.01;
   setDragState(run, air_speed);
-  const auto ijk = run.layout->cellIndex();
   const LocalOrdinal owned = run.layout->ownedCells();
   const double h = 0.01, V = h * h;
   auto relative = [&](std::vector<double>& w) {
@@ -375,16 +391,8 @@ DragSceneOutcome runDragScene(double K, int steps)
       out.failure = failure.what();
       break;
     }
-    // The walls' pressure impulse (p − p0: a uniform pressure pushes both walls of a pair alike).
-    const auto p = run.state.pressure.view();
-    double local[2] = {0, 0};
-    for (LocalOrdinal c = 0; c < owned; ++c) {
-      if (ijk(c, 0) == 0) local[0] += (p(c, 0) - kPressure) * h;
-      if (ijk(c, 0) == 9) local[0] -= (p(c, 0) - kPressure) * h;
-      if (ijk(c, 1) == 0) local[1] += (p(c, 0) - kPressure) * h;
-      if (ijk(c, 1) == 9) local[1] -= (p(c, 0) - kPressure) * h;
-    }
-    for (int d = 0; d < 2; ++d) impulse[d] += kDragDt * globalSum(*world(), local[d]);
+    const std::array<double, 2> force = wallPressureForce(run, h, 10);
+    for (int d = 0; d < 2; ++d) impulse[d] += kDragDt * force[d];
     const double largest_new = relative(w_new);
     if (k == 0) out.first_ratio = largest_new / largest_old;
     // The bound of an exchange that never amplifies. Within a step the pressure force gives the two
@@ -843,7 +851,6 @@ CoupledDragOutcome runCoupledDrag(double K, int steps)
   const int water = 1;  // the solids come first
   const auto total = [&] { return run.fluidMomentum(water, 0) + run.particles().momentum()[0]; };
   const double disk0 = run.particles().momentum()[0], start = total();
-  const auto ijk = run.layout->cellIndex();
   auto relative = [&] {
     const auto u = run.state.velocity.view();
     const auto theta = run.state.volume_fraction.view();
@@ -862,13 +869,7 @@ CoupledDragOutcome runCoupledDrag(double K, int steps)
       out.failure = failure.what();
       break;
     }
-    const auto p = run.state.pressure.view();
-    double local = 0;
-    for (LocalOrdinal c = 0; c < run.layout->ownedCells(); ++c) {
-      if (ijk(c, 0) == 0) local += (p(c, 0) - kPressure) * h;
-      if (ijk(c, 0) == 19) local -= (p(c, 0) - kPressure) * h;
-    }
-    impulse += kDragDt * globalSum(*world(), local);
+    impulse += kDragDt * wallPressureForce(run, h, 20)[0];
     const double w = relative() / 0.5;
     if (n == 0) out.first_ratio = w;
     out.last_ratio = w;

@@ -3,6 +3,7 @@
 #include "common/error.hpp"
 #include "io/collective.hpp"
 #include "io/hdf5_common.hpp"
+#include "io/hdf5_writer.hpp"
 
 #include <hdf5.h>
 
@@ -60,7 +61,7 @@ void Hdf5Reader::fail(const std::string& what) const
 
 bool Hdf5Reader::hasAttribute(const std::string& name) const
 {
-  return H5Aexists(file_, name.c_str()) > 0;
+  return H5Aexists(file_, name.c_str()) > 0 || hasDataset(kTextDatasetGroup + name);
 }
 
 std::int64_t Hdf5Reader::openAttribute(const std::string& name) const
@@ -107,6 +108,16 @@ std::vector<long long> Hdf5Reader::attributeIntegers(const std::string& name) co
 
 std::string Hdf5Reader::attributeText(const std::string& name) const
 {
+  const std::string long_text = kTextDatasetGroup + name;  // Hdf5Writer's form of a long text
+  if (H5Aexists(file_, name.c_str()) <= 0 && hasDataset(long_text)) {
+    const std::vector<long long> dims = datasetDims(long_text);
+    if (dims.size() != 1) fail("dataset " + long_text + " is not a text");
+    std::string text(std::size_t(dims[0]), '\0');
+    H5Handle set(H5Dopen2(file_, long_text.c_str(), H5P_DEFAULT), H5Dclose);
+    if (H5Dread(set.get(), H5T_NATIVE_UCHAR, H5S_ALL, H5S_ALL, H5P_DEFAULT, text.data()) < 0)
+      fail("dataset " + long_text + " cannot be read");
+    return text.substr(0, text.find('\0'));
+  }
   H5Handle attribute(openAttribute(name), H5Aclose);
   H5Handle type(H5Aget_type(attribute.get()), H5Tclose);
   if (H5Tget_class(type.get()) != H5T_STRING || H5Tis_variable_str(type.get()) > 0)

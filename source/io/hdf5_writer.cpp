@@ -284,17 +284,41 @@ void Hdf5Writer::writeAttribute(const std::string& name, const std::vector<long 
 void Hdf5Writer::writeAttribute(const std::string& name, const std::string& text)
 {
   if (!open_) throw std::logic_error("Hdf5Writer: attribute '" + name + "' outside beginStep/endStep");
+  const std::string stored = text.empty() ? std::string(1, '\0') : text;
+  if (stored.size() > kLargestTextAttribute) {
+    // An object header holds at most 64 KiB of attributes (HDF5's compact storage), and a run's
+    // record of written steps outgrows that after some tens of outputs: a long text goes into the
+    // byte dataset /attributes/<name> instead, which Hdf5Reader::attributeText reads the same way.
+    const hsize_t length = stored.size();
+    H5Handle file_space(checked(H5Screate_simple(1, &length, nullptr), "dataspace of " + name), H5Sclose);
+    H5Handle memory_space(checked(H5Screate_simple(1, &length, nullptr), "memory dataspace"), H5Sclose);
+    const std::string path = std::string(kTextDatasetGroup) + name;
+    H5Handle dataset(checked(H5Dcreate2(open_->file.get(), path.c_str(), H5T_STD_U8LE, file_space.get(),
+                                        open_->link_creation.get(), open_->dataset_creation.get(), H5P_DEFAULT),
+                             "creating dataset " + path),
+                     H5Dclose);
+    // The same text on every rank: rank 0 writes it, the others select nothing (collective write).
+    int rank = 0;
+    MPI_Comm_rank(comm_, &rank);
+    if (rank != 0) {
+      checked(H5Sselect_none(file_space.get()), "H5Sselect_none");
+      checked(H5Sselect_none(memory_space.get()), "H5Sselect_none");
+    }
+    checked(H5Dwrite(dataset.get(), H5T_NATIVE_UCHAR, memory_space.get(), file_space.get(), open_->transfer.get(),
+                     stored.data()),
+            "writing dataset " + path);
+    return;
+  }
   // A variable-length string would be stored in the global heap; a fixed-length one of the text's
   // size (at least 1) reads back with h5py as bytes and needs no collective heap writes.
   H5Handle type(checked(H5Tcopy(H5T_C_S1), "string type"), H5Tclose);
-  checked(H5Tset_size(type.get(), std::max<std::size_t>(1, text.size())), "H5Tset_size");
+  checked(H5Tset_size(type.get(), stored.size()), "H5Tset_size");
   checked(H5Tset_strpad(type.get(), H5T_STR_NULLPAD), "H5Tset_strpad");
   H5Handle space(checked(H5Screate(H5S_SCALAR), "dataspace of attribute " + name), H5Sclose);
   H5Handle attribute(checked(H5Acreate2(open_->file.get(), name.c_str(), type.get(), space.get(), H5P_DEFAULT,
                                         H5P_DEFAULT),
                              "creating attribute " + name),
                      H5Aclose);
-  const std::string stored = text.empty() ? std::string(1, '\0') : text;
   checked(H5Awrite(attribute.get(), type.get(), stored.data()), "writing attribute " + name);
 }
 

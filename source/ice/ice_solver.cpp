@@ -28,6 +28,23 @@ constexpr double kNegligibleMassShare = 1e-12;
 // Likewise on a face: a material filling less than this share of both neighbours has no face
 // velocity of its own (a denormal volume fraction would leave it uncoupled by the exchange).
 constexpr double kNegligibleVolumeShare = 1e-12;
+// The share of its volume a material loses to a pressure change, v_L = v (1 − s(κ Σδp)): x to
+// first order (Uintah's computeLagrangianSpecificVolume), but for a compression the isothermal
+// gas's x / (1 + x) (v_L = v / (1 + x)), which has the same value and slope at x = 0 and leaves the
+// volume positive. The
+// linear form makes a gas's volume negative once one step raises its pressure by more than γ times
+// itself: in the slide a trace of air (θ ~ 1e-9) in a cell the sand had just left did so at 0.465 s;
+// its negative volume then made room for water 11 % over its density in the pressure equation, the
+// pressure fell to zero and the run failed within 30 steps. Both the Lagrangian volumes and the
+// pressure equation's residual use it (the matrix keeps the slope at x = 0, Σθκ).
+KOKKOS_INLINE_FUNCTION double volumeLoss(double x) { return x > 0 ? x / (1.0 + x) : x; }
+KOKKOS_INLINE_FUNCTION double volumeLossSlope(double x) { return x > 0 ? 1.0 / ((1.0 + x) * (1.0 + x)) : 1.0; }
+// The pressure matrix's Σθκ is the slope of that loss at Σδp = 0. Where a gas is compressed
+// strongly in one step the slope falls (by 1/(1 + x)²), and an outer iteration with the old one
+// takes steps too short to converge: the matrix follows the slope once it has fallen by more than
+// this share somewhere (then each outer iteration contracts by at least as much).
+constexpr double kCompressibilityChange = 0.1;
+
 // Next to a solid the fluids fill the room it leaves on a face (fluidFaceFractions) where the donor
 // holds more than kSolidPresent of solids and its fluids' profiles more than kFillMinimum of the face.
 constexpr double kSolidPresent = 1e-6;
@@ -528,7 +545,7 @@ void IceSolver<Dim>::carriedFaceBeta()
 }
 
 // [5] Right-hand side of the pressure equation, −Δt Σ_faces A Σ_m θ_upwind,m u_f,m · n_out
-// − V κ Σδp (the outer-iteration residual form of Uintah's setupRHS), plus the solids' own change
+// − V Σ_m θ_m s(κ_m Σδp) (≈ V Σθκ Σδp; the outer-iteration residual form of Uintah's setupRHS), plus the solids' own change
 // of volume V Σ_s Δθ_s (solidVolumeChange); returns max |rhs| / V.
 // after_solve: first apply the solve's δp, in the same pass: Σδp += δp, p = p_eq + Σδp, and every
 // face velocity u_f −= Δt v_f (δp_R − δp_L) / h (owned cells; the ghosts of p and Σδp are not read
@@ -541,7 +558,7 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
   const int n = materials_;
   const auto neighbours = layout_->cellNeighbours();
   const auto theta = state.volume_fraction.view();
-  const auto sum_kappa = mixture_compressibility_.view();
+  const auto kappa = compressibility_.view();
   auto sum_dp = sum_delta_p_.view();
   const auto dp = delta_p_.view();
   auto p = state.pressure.view();
@@ -619,7 +636,9 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
           if (roles.any_solid)
             for (int m = 0; m < nm; ++m)
               if (roles.lagrangian[m]) solid_change += solid_change_view(c, m);
-          rhs(c, 0) = volume * solid_change - dt * outflow - volume * sum_kappa(c, 0) * sum_dp(c, 0);
+          double compression = 0;  // Σ_m θ_m s(κ_m Σδp): the share of the cell the pressure change takes
+          for (int m = 0; m < nm; ++m) compression += theta(c, m) * volumeLoss(kappa(c, m) * sum_dp(c, 0));
+          rhs(c, 0) = volume * solid_change - dt * outflow - volume * compression;
           const double a = Kokkos::Experimental::fabs(rhs(c, 0));
           if (a > worst) worst = a;
         },
@@ -779,7 +798,7 @@ void IceSolver<Dim>::momentumSourcePhase(CellState<Dim>& state, double dt)
               const double force = -t[m] * grad_p[k] + mu[m] * t[m] * laplacian + r[m] * g[k];  // per volume
               un(c, m * Dim + k) = uc + dt * force / r[m];  // (not dt / ρ first: ρ can be subnormal)
             }
-            v(c, m) = v(c, m) * (1.0 - kappa(c, m) * sum_dp(c, 0));
+            v(c, m) = v(c, m) * (1.0 - volumeLoss(kappa(c, m) * sum_dp(c, 0)));
           }
         });
   });
@@ -1104,11 +1123,42 @@ void IceSolver<Dim>::pressurePhase(CellState<Dim>& state, double dt, IceStepRepo
     }
     // p = p_eq + Σδp and the faces corrected with this iteration's δp, then the new residual.
     residual = pressureRightHandSide(state, dt, true);
+    if (residual > settings_.outer_tolerance && followCompressibility(state))
+      pressure_solver_->assemble(mixture_compressibility_, face_beta_, dt);
   }
   report.outer_residual = residual;
   report.converged = residual <= settings_.outer_tolerance || !implicit;
 
 
+}
+
+template <int Dim>
+bool IceSolver<Dim>::followCompressibility(const CellState<Dim>& state)
+{
+  const int n = materials_;
+  const auto theta = state.volume_fraction.view();
+  const auto kappa = compressibility_.view();
+  const auto sum_dp = sum_delta_p_.view();
+  auto sum_kappa = mixture_compressibility_.view();
+  const auto slope = KOKKOS_LAMBDA(const LocalOrdinal c) {
+    double sk = 0;
+    for (int m = 0; m < n; ++m) sk += theta(c, m) * kappa(c, m) * volumeLossSlope(kappa(c, m) * sum_dp(c, 0));
+    return sk;
+  };
+  int local = 0;
+  Kokkos::parallel_reduce(
+      "ice::compressibilityFallen", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+      KOKKOS_LAMBDA(const LocalOrdinal c, int& fallen) {
+        if (slope(c) < (1.0 - kCompressibilityChange) * sum_kappa(c, 0)) fallen = 1;
+      },
+      Kokkos::Max<int>(local));
+  int global = 0;
+  Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_MAX, local, Teuchos::outArg(global));
+  if (global == 0) return false;
+  Kokkos::parallel_for(
+      "ice::followCompressibility", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+      KOKKOS_LAMBDA(const LocalOrdinal c) { sum_kappa(c, 0) = slope(c); });
+  return true;
 }
 
 // [10] Advection of mass, velocity and specific volume of the fluids by the corrected face

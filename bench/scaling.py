@@ -67,9 +67,9 @@ def scenes(source, out):
     s = slide["cfdmpm"]
     s["time"]["max_steps"] = 12
     s["output"] = {"directory": "OUTPUT", "interval": s["time"]["end_time"], "fields": ["pressure"]}
-    for mm, cells in ((20, [175, 101]), (10, [350, 202]), (5, [700, 404])):
+    for mm in (20, 10, 5):
         t = copy.deepcopy(slide)
-        t["cfdmpm"]["domain"]["cells"] = cells
+        t["cfdmpm"]["domain"]["cell_size"] = mm / 1000  # 176 x 102, 352 x 204, 704 x 408 cells
         flow_dump(t, os.path.join(out, "slide2d_%dmm.yaml" % mm))
         if mm == 10:
             for m in ("bed", "sand"):
@@ -83,7 +83,7 @@ def scenes(source, out):
     t = copy.deepcopy(slide)
     d = t["cfdmpm"]
     dom = d["domain"]
-    dom.update(dimension=3, lower=dom["lower"] + [0.0], upper=dom["upper"] + [0.2], cells=[175, 101, 10],
+    dom.update(dimension=3, lower=dom["lower"] + [0.0], upper=dom["upper"] + [0.2], cell_size=0.02,
                patch_cells=[16, 16, 16], gravity=dom["gravity"] + [0.0])
     for region in d["regions"].values():
         if region["shape"] == "half_plane":

@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -641,6 +642,48 @@ std::string showPoint(const std::array<double, 3>& point, int dimension)
 
 // --- The sections ----------------------------------------------------------------------------
 
+// A length or count for a message, to 10 significant digits: 3.52 rather than 3.5199999999999996.
+std::string showRounded(double value)
+{
+  char text[32];
+  std::snprintf(text, sizeof text, "%.10g", value);
+  return text;
+}
+
+// `cells` from `cell_size`: (upper - lower) / cell_size in every direction, which must be a whole
+// number (to a relative 1e-9, the round-off of the division).
+Array<int> cellsOfSize(const ParameterList& list, const std::string& path, int dimension,
+                       const std::array<double, 3>& lower, const std::array<double, 3>& upper)
+{
+  const std::string key = path + ".cell_size";
+  const double size = list.get<double>("cell_size");
+  const std::string given = key + ": got " + shownValue(key, list.getEntry("cell_size")) + "; ";
+  std::string extents = "[";
+  for (int i = 0; i < dimension; ++i) extents += (i ? ", " : "") + showRounded(upper[i] - lower[i]);
+  extents += "] m";
+  const char* const axes[] = {"x", "y", "z"};
+  Array<int> cells(dimension);
+  for (int i = 0; i < dimension; ++i) {
+    const double extent = upper[i] - lower[i];
+    const double count = extent / size;
+    const double whole = std::round(count);
+    if (whole < 1 || std::abs(count - whole) > 1e-9 * count) {
+      throw InputError(given + "it does not divide the domain in " + axes[i] + ": upper - lower = " +
+                       showRounded(extent) + " m holds " + showRounded(count) + " cells of " + showRounded(size) +
+                       " m, not a whole number; cell_size must divide the extent upper - lower = " + extents +
+                       " into a whole number of cells in every direction, or give `cells` (cells per "
+                       "direction) instead of cell_size");
+    }
+    if (whole > double(std::numeric_limits<int>::max())) {
+      throw InputError(given + "it makes " + showRounded(whole) + " cells in " + axes[i] + ", more than the " +
+                       std::to_string(std::numeric_limits<int>::max()) +
+                       " a direction may have; use a larger cell_size");
+    }
+    cells[i] = static_cast<int>(whole);
+  }
+  return cells;
+}
+
 DomainSpec readDomain(ParameterList& list)
 {
   const std::string path = kRoot + ".domain";
@@ -651,31 +694,46 @@ DomainSpec readDomain(ParameterList& list)
   const int dimension = list.get<int>("dimension");
   checkKeys(list, valid, path, dimension);
 
-  const auto& cells = list.get<Array<int>>("cells");
-  if (!list.isParameter("patch_cells")) {
-    Array<int> patch_cells(dimension);
-    for (int i = 0; i < dimension; ++i) patch_cells[i] = std::min(16, cells[i]);
-    list.set("patch_cells", patch_cells);
-  }
-  setDefaults(list, valid, path);
-
   DomainSpec domain;
   domain.dimension = dimension;
   domain.lower = padded<double>(list.get<Array<double>>("lower"), 0.0);
   domain.upper = padded<double>(list.get<Array<double>>("upper"), 1.0);
-  domain.cells = padded<long long>(cells, 1LL);
-  domain.patch_cells = padded<long long>(list.get<Array<int>>("patch_cells"), 1LL);
-  for (int i = 0; i < 3; ++i) domain.patch_cells[i] = std::min(domain.patch_cells[i], domain.cells[i]);
-  domain.ghost_width = list.get<int>("ghost_width");
-  domain.gravity = padded<double>(list.get<Array<double>>("gravity"), 0.0);
-  domain.rebalance_interval = list.get<int>("rebalance_interval");
-
   for (int i = 0; i < dimension; ++i) {
     if (!(domain.upper[i] > domain.lower[i])) {
       throw inputError(path + ".upper", showPoint(domain.upper, dimension),
                        "must be above lower = " + showPoint(domain.lower, dimension) + " in every direction");
     }
   }
+
+  // The cells: counted per direction (`cells`) or from one edge length (`cell_size`), never both.
+  // From here on the list holds `cells` either way, as if the file had given it.
+  const bool cells_given = list.isParameter("cells");
+  const bool size_given = list.isParameter("cell_size");
+  if (cells_given == size_given) {
+    throw InputError(path + ": " +
+                     (cells_given ? "both `cells` (" + showValue(list.getEntry("cells")) + ") and `cell_size` (" +
+                                        showValue(list.getEntry("cell_size")) + ") are given"
+                                  : std::string("neither `cells` nor `cell_size` is given")) +
+                     "; give exactly one of them: " + path + ".cells, " + std::to_string(dimension) +
+                     " integers (the cells per direction), or " + path +
+                     ".cell_size, a number > 0 (m) (the cells' edge length, the same in every direction)");
+  }
+  if (size_given) list.set("cells", cellsOfSize(list, path, dimension, domain.lower, domain.upper));
+  const Array<int> cells = list.get<Array<int>>("cells");
+  if (!list.isParameter("patch_cells")) {
+    Array<int> patch_cells(dimension);
+    for (int i = 0; i < dimension; ++i) patch_cells[i] = std::min(16, cells[i]);
+    list.set("patch_cells", patch_cells);
+  }
+  setDefaults(list, valid, path);
+  if (!size_given) list.remove("cell_size");  // not given: no default stands in for it
+
+  domain.cells = padded<long long>(cells, 1LL);
+  domain.patch_cells = padded<long long>(list.get<Array<int>>("patch_cells"), 1LL);
+  for (int i = 0; i < 3; ++i) domain.patch_cells[i] = std::min(domain.patch_cells[i], domain.cells[i]);
+  domain.ghost_width = list.get<int>("ghost_width");
+  domain.gravity = padded<double>(list.get<Array<double>>("gravity"), 0.0);
+  domain.rebalance_interval = list.get<int>("rebalance_interval");
   return domain;
 }
 

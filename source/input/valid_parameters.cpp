@@ -110,7 +110,15 @@ void defineDomain(ParameterList& domain)
   define(domain, "lower", zeros(2), "Lower corner of the domain (x, y[, z]).", required(perDirection(unit("m"))));
   define(domain, "upper", zeros(2), "Upper corner of the domain; above `lower` in every direction.",
          required(perDirection(unit("m"))));
-  define(domain, "cells", Array<int>(2, 1), "Number of cells per direction.", required(perDirection(atLeast(1))));
+  // `cells` and `cell_size`: exactly one of the two is given (readDomain checks it, and derives
+  // `cells` from `cell_size`).
+  define(domain, "cells", Array<int>(2, 1),
+         "Number of cells per direction. Give exactly one of `cells` and `cell_size`.",
+         derivedDefault(perDirection(atLeast(1)), "required unless `cell_size` is given"));
+  define(domain, "cell_size", 0.01,
+         "Edge length of the cells, the same in every direction: `cells` is then (upper - lower) / cell_size, "
+         "which must be a whole number in every direction. Give exactly one of `cells` and `cell_size`.",
+         derivedDefault(positive("m"), "required unless `cells` is given"));
   define(domain, "patch_cells", Array<int>(2, 16),
          "Patch size in cells per direction; patches are the units of the domain decomposition. Values above "
          "`cells` are clipped to it.",

@@ -96,8 +96,50 @@ TEST_F(SceneTest, EmptyFileIsRefused)
 
 TEST_F(SceneTest, MissingRequiredKeyNamesKeyAndExpectation)
 {
-  const std::string message = errorOf(replaced(kFullScene, "    cells: [20, 10]\n", ""));
-  expectMentions(message, {"cfdmpm.domain.cells", "required key is missing", "a list of 2 integers", ">= 1"});
+  const std::string message = errorOf(replaced(kFullScene, "    gravity: [0.0, -9.81]\n", ""));
+  expectMentions(message, {"cfdmpm.domain.gravity", "required key is missing", "a list of 2 numbers"});
+}
+
+TEST_F(SceneTest, CellsAndCellSizeTogetherOrNeitherAreRefused)
+{
+  const std::string both = errorOf(replaced(kFullScene, "    cells: [20, 10]\n", "    cells: [20, 10]\n    cell_size: 0.05\n"));
+  expectMentions(both, {"scene.yaml", "cfdmpm.domain: both `cells` ([20, 10]) and `cell_size` (0.05) are given",
+                        "give exactly one of them", "cfdmpm.domain.cells", "cfdmpm.domain.cell_size", "> 0 (m)"});
+  const std::string neither = errorOf(replaced(kFullScene, "    cells: [20, 10]\n", ""));
+  expectMentions(neither, {"scene.yaml", "cfdmpm.domain: neither `cells` nor `cell_size` is given",
+                           "give exactly one of them", "cfdmpm.domain.cells, 2 integers (the cells per direction)",
+                           "cfdmpm.domain.cell_size, a number > 0 (m)"});
+}
+
+TEST_F(SceneTest, CellSizeThatDoesNotDivideTheDomainIsRefused)
+{
+  // x: 1 m / 0.3 m = 3.33 cells.
+  const std::string in_x = errorOf(replaced(kFullScene, "cells: [20, 10]", "cell_size: 0.3"));
+  expectMentions(in_x, {"cfdmpm.domain.cell_size: got '0.3'", "does not divide the domain in x",
+                        "upper - lower = 1 m holds 3.333333333 cells of 0.3 m, not a whole number",
+                        "must divide the extent upper - lower = [1, 1] m into a whole number of cells in every "
+                        "direction", "or give `cells`"});
+  // y: 1.05 m / 0.1 m = 10.5 cells (x divides: 10 cells).
+  const std::string in_y = errorOf(
+      replaced(replaced(kFullScene, "cells: [20, 10]", "cell_size: 1.0e-1"), "upper: [1.0, 0.5]", "upper: [1.0, 0.55]"));
+  expectMentions(in_y, {"cfdmpm.domain.cell_size: got '1.0e-1'", "does not divide the domain in y",
+                        "upper - lower = 1.05 m holds 10.5 cells of 0.1 m", "[1, 1.05] m", "or give `cells`"});
+  // Larger than the domain: less than one cell.
+  expectMentions(errorOf(replaced(kFullScene, "cells: [20, 10]", "cell_size: 2.0")),
+                 {"cfdmpm.domain.cell_size: got '2.0'", "in x", "holds 0.5 cells of 2 m"});
+}
+
+TEST_F(SceneTest, CellSizeOutOfRangeIsRefused)
+{
+  expectMentions(errorOf(replaced(kFullScene, "cells: [20, 10]", "cell_size: 0")),
+                 {"cfdmpm.domain.cell_size", "got '0'", "> 0 (m)"});
+  expectMentions(errorOf(replaced(kFullScene, "cells: [20, 10]", "cell_size: -0.05")),
+                 {"cfdmpm.domain.cell_size", "got '-0.05'", "> 0 (m)"});
+  expectMentions(errorOf(replaced(kFullScene, "cells: [20, 10]", "cell_size: [0.05, 0.1]")),
+                 {"cfdmpm.domain.cell_size", "[0.05, 0.1]", "expected a number"});
+  expectMentions(errorOf(replaced(kFullScene, "cells: [20, 10]", "cell_size: 1.0e-10")),
+                 {"cfdmpm.domain.cell_size: got '1.0e-10'", "it makes 1e+10 cells in x", "more than the 2147483647",
+                  "larger cell_size"});
 }
 
 TEST_F(SceneTest, MissingRequiredSectionNamesIt)
@@ -122,7 +164,7 @@ TEST_F(SceneTest, UnknownKeyListsAllowedKeys)
 {
   const std::string message = errorOf(replaced(kFullScene, "ghost_width: 3", "ghost_widht: 3"));
   expectMentions(message, {"cfdmpm.domain.ghost_widht", "unknown key",
-                           "dimension, lower, upper, cells, patch_cells, ghost_width, gravity"});
+                           "dimension, lower, upper, cells, cell_size, patch_cells, ghost_width, gravity"});
 }
 
 TEST_F(SceneTest, UnknownKeyInsideAMaterialIsCaught)

@@ -54,9 +54,9 @@ TEST(SceneFiles, DamBreakIsMartinAndMoyceColumnInATank)
 TEST(SceneFiles, RzadkiewiczSlideHasBedSandWaterAndAir)
 {
   const Scene scene = readScene((kInputDirectory / "rzadkiewicz.yaml").string());
-  EXPECT_EQ(scene.domain.lower, (std::array<double, 3>{-2.0, -0.02, 0.0}));
+  EXPECT_EQ(scene.domain.lower, (std::array<double, 3>{-2.02, -0.04, 0.0}));
   EXPECT_EQ(scene.domain.upper, (std::array<double, 3>{1.5, 2.0, 1.0}));
-  EXPECT_EQ(scene.domain.cells, (std::array<long long, 3>{350, 202, 1}));  // 10 mm cells
+  EXPECT_EQ(scene.domain.cells, (std::array<long long, 3>{352, 204, 1}));  // cell_size: 10 mm
   ASSERT_EQ(scene.materials.size(), 4u);
   EXPECT_EQ(scene.materials[scene.materialIndex("bed")].parameters.sublist("model").get<std::string>("type"), "rigid");
   const auto& sand = scene.materials[scene.materialIndex("sand")].parameters;

@@ -229,6 +229,79 @@ TEST_F(SceneTest, ThreeDimensionalSceneHasSixFacesAndThreeComponents)
   EXPECT_EQ(scene.materials[1].parameters.sublist("model").get<Array<double>>("velocity"), Array<double>(3, 0.0));
 }
 
+// `cell_size` gives the DomainSpec (and the domain list) that the equivalent `cells` gives.
+void expectSameDomain(const Scene& a, const Scene& b)
+{
+  EXPECT_EQ(a.domain.dimension, b.domain.dimension);
+  EXPECT_EQ(a.domain.lower, b.domain.lower);
+  EXPECT_EQ(a.domain.upper, b.domain.upper);
+  EXPECT_EQ(a.domain.cells, b.domain.cells);
+  EXPECT_EQ(a.domain.patch_cells, b.domain.patch_cells);
+  EXPECT_EQ(a.domain.ghost_width, b.domain.ghost_width);
+  EXPECT_EQ(a.domain.gravity, b.domain.gravity);
+  EXPECT_EQ(a.domain.rebalance_interval, b.domain.rebalance_interval);
+  EXPECT_EQ(a.parameters->sublist("domain").get<Array<int>>("cells"),
+            b.parameters->sublist("domain").get<Array<int>>("cells"));
+  EXPECT_EQ(a.parameters->sublist("domain").get<Array<int>>("patch_cells"),
+            b.parameters->sublist("domain").get<Array<int>>("patch_cells"));
+}
+
+TEST_F(SceneTest, CellSizeGivesTheSameDomainAsCells)
+{
+  // The full scene's domain, [0, 1] x [-0.5, 0.5] m: cell_size 0.05 m is 20 x 20 cells.
+  const std::string by_cells = replaced(kFullScene, "cells: [20, 10]", "cells: [20, 20]");
+  const std::string by_size = replaced(kFullScene, "cells: [20, 10]", "cell_size: 0.05");
+  const Scene a = readScene(write(by_cells, "cells.yaml"));
+  const Scene b = readScene(write(by_size, "size.yaml"));
+  EXPECT_EQ(b.domain.cells, (std::array<long long, 3>{20, 20, 1}));
+  EXPECT_EQ(b.domain.patch_cells, (std::array<long long, 3>{10, 5, 1}));  // as given
+  expectSameDomain(a, b);
+  // The list keeps the key given and no stand-in for the other.
+  EXPECT_FALSE(a.parameters->sublist("domain").isParameter("cell_size"));
+  EXPECT_EQ(b.parameters->sublist("domain").get<double>("cell_size"), 0.05);
+
+  // patch_cells left out: 16 per direction, clipped to the cells cell_size gives (40 x 10).
+  const std::string minimal = replaced(kMinimalScene, "upper: [1, 2]", "upper: [1, 0.25]");
+  const Scene c = readScene(write(minimal, "minimal-cells.yaml"));
+  const Scene d = readScene(write(replaced(minimal, "cells: [40, 10]", "cell_size: 0.025"), "minimal-size.yaml"));
+  EXPECT_EQ(d.domain.cells, (std::array<long long, 3>{40, 10, 1}));
+  EXPECT_EQ(d.domain.patch_cells, (std::array<long long, 3>{16, 10, 1}));
+  expectSameDomain(c, d);
+
+  // An integer cell size is a number too.
+  const Scene e = readScene(write(replaced(replaced(kMinimalScene, "cells: [40, 10]", "cell_size: 1"), "upper: [1, 2]",
+                                           "upper: [3, 2]"),
+                                  "integer.yaml"));
+  EXPECT_EQ(e.domain.cells, (std::array<long long, 3>{3, 2, 1}));
+}
+
+TEST_F(SceneTest, CellSizeDividesExtentsWithinRoundOff)
+{
+  // The seed scene's domain, 3.52 m x 2.04 m, at 40, 20, 10 and 5 mm: the extents (differences of
+  // doubles) divided by the size are whole numbers to within round-off.
+  const std::string domain = replaced(replaced(kMinimalScene, "lower: [0, 0]", "lower: [-2.02, -0.04]"),
+                                      "upper: [1, 2]", "upper: [1.5, 2.0]");
+  const std::vector<std::pair<std::string, std::array<long long, 3>>> sizes{
+      {"0.04", {88, 51, 1}}, {"0.02", {176, 102, 1}}, {"0.01", {352, 204, 1}}, {"0.005", {704, 408, 1}}};
+  for (const auto& [size, cells] : sizes) {
+    const Scene scene = readScene(write(replaced(domain, "cells: [40, 10]", "cell_size: " + size), size + ".yaml"));
+    EXPECT_EQ(scene.domain.cells, cells) << "cell_size " << size;
+    EXPECT_EQ(scene.domain.patch_cells, (std::array<long long, 3>{16, 16, 1})) << "cell_size " << size;
+  }
+  // 3-D: the third direction is divided too.
+  const std::string three_d = R"(cfdmpm:
+  domain: {dimension: 3, lower: [0, 0, 0], upper: [1, 0.5, 0.2], cell_size: 0.1, gravity: [0, 0, -9.81]}
+  materials:
+    air: {kind: fluid, equation_of_state: {type: ideal_gas}, viscosity: 1.8e-5}
+  initial_state: {background_material: air}
+  time: {end_time: 1}
+  output: {directory: out, interval: 0.5}
+)";
+  const Scene scene = readScene(write(three_d, "3d.yaml"));
+  EXPECT_EQ(scene.domain.cells, (std::array<long long, 3>{10, 5, 2}));
+  EXPECT_EQ(scene.domain.patch_cells, (std::array<long long, 3>{10, 5, 2}));
+}
+
 TEST_F(SceneTest, RegionOnTheDomainBoundaryWithinRoundOffIsAccepted)
 {
   // 1e-13 beyond a 1 m domain is round-off (the tolerance is 1e-12 of the domain size).

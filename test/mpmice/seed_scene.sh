@@ -5,10 +5,10 @@ set -eu
 ranks=$1
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-sed -e "s|directory: .*|directory: $work/out|" -e "s|cells: \[350, 202\]|cells: [175, 101]|" \
+sed -e "s|directory: .*|directory: $work/out|" -e "s|^    cell_size: 0.01 .*|    cell_size: 0.02|" \
     -e "s|    end_time: 0.8|    end_time: 0.1|" -e "s|    fields: .*|    fields: [volume_fraction, velocity, pressure, particle_velocity, particle_material]|" \
     "$SOURCE_DIR/input/rzadkiewicz.yaml" > "$work/slide.yaml"
-grep -q "cells: \[175, 101\]" "$work/slide.yaml"
+grep -q "^    cell_size: 0.02$" "$work/slide.yaml"
 grep -q "end_time: 0.1" "$work/slide.yaml"
 "$MPIEXEC" -n "$ranks" "$CFDMPM" "$work/slide.yaml" > "$work/log"
 /usr/bin/python3 "$SOURCE_DIR/test/mpmice/check_seed_scene.py" "$work/out"

@@ -28,9 +28,22 @@ Scene fluidsOnly(const Scene& scene)
   return fluids;
 }
 
+/// The coupled step's phases, with the pressure phase of the ICE step after "3-6 fluid pressure".
+std::vector<std::string> phases()
+{
+  std::vector<std::string> all;
+  for (const char* phase : MpmIceStep<2>::kPhases) {
+    all.emplace_back(phase);
+    if (all.back() == "3-6 fluid pressure") all.emplace_back("5 pressure");
+  }
+  return all;
+}
+
 /// Runs `steps` steps of dt after 5 warm-up steps; returns the slowest rank's seconds per phase.
+/// Also the outer and linear (CG) pressure iterations per step, and the ICE pressure phase [5] alone
+/// (outer iterations, matrix, solves) as the phase "5 pressure" (inside "3-6 fluid pressure").
 std::map<std::string, double> measure(const Scene& scene, int steps, double dt, double& outer_per_step,
-                                      const Teuchos::RCP<const Teuchos::Comm<int>>& comm)
+                                      double& linear_per_step, const Teuchos::RCP<const Teuchos::Comm<int>>& comm)
 {
   test::CoupledRun<2> run(scene, comm);
   const auto advance = [&] {
@@ -39,15 +52,20 @@ std::map<std::string, double> measure(const Scene& scene, int steps, double dt, 
   };
   for (int s = 0; s < 5; ++s) advance();
   std::map<std::string, double> before, spent;
-  for (const char* phase : MpmIceStep<2>::kPhases) before[phase] = run.stepper.phaseSeconds(phase);
-  long long outer = 0;
+  const auto seconds = [&](const std::string& phase) {
+    return phase == "5 pressure" ? run.stepper.fluids()->phaseSeconds("pressure") : run.stepper.phaseSeconds(phase);
+  };
+  for (const std::string& phase : phases()) before[phase] = seconds(phase);
+  long long outer = 0, linear = 0;
   for (int s = 0; s < steps; ++s) {
     advance();
     outer += run.last.ice.outer_iterations;
+    linear += run.last.ice.linear_iterations;
   }
   outer_per_step = double(outer) / steps;
-  for (const char* phase : MpmIceStep<2>::kPhases) {
-    double local = run.stepper.phaseSeconds(phase) - before[phase], slowest = 0;
+  linear_per_step = double(linear) / steps;
+  for (const std::string& phase : phases()) {
+    double local = seconds(phase) - before[phase], slowest = 0;
     Teuchos::reduceAll(*comm, Teuchos::REDUCE_MAX, local, Teuchos::outArg(slowest));
     spent[phase] = slowest;
   }
@@ -66,18 +84,20 @@ int main(int argc, char** argv)
     const double dt = argc > 2 ? std::atof(argv[2]) : 2e-5;
     const Scene scene = readScene(std::string(CFDMPM_SOURCE_DIR) + "/input/rzadkiewicz.yaml");
     const double cells = double(scene.domain.cells[0] * scene.domain.cells[1]);
-    double outer_coupled = 0, outer_fluid = 0;
-    const auto coupled = measure(scene, steps, dt, outer_coupled, comm);
-    const auto fluid = measure(fluidsOnly(scene), steps, dt, outer_fluid, comm);
+    double outer_coupled = 0, outer_fluid = 0, linear_coupled = 0, linear_fluid = 0;
+    const auto coupled = measure(scene, steps, dt, outer_coupled, linear_coupled, comm);
+    const auto fluid = measure(fluidsOnly(scene), steps, dt, outer_fluid, linear_fluid, comm);
     if (root) {
       std::cout << "Rzadkiewicz slide, " << scene.domain.cells[0] << " x " << scene.domain.cells[1] << " cells, "
                 << comm->getSize() << " rank(s), " << steps << " steps of " << dt << " s\n"
                 << "outer pressure iterations per step: coupled " << outer_coupled << ", fluids alone " << outer_fluid
                 << "\n"
+                << "linear (CG) iterations per step: coupled " << linear_coupled << ", fluids alone " << linear_fluid
+                << "\n"
                 << std::left << std::setw(26) << "phase" << std::right << std::setw(16) << "coupled us/c-s"
                 << std::setw(16) << "fluids us/c-s" << "\n"
                 << std::fixed << std::setprecision(3);
-      for (const char* phase : MpmIceStep<2>::kPhases)
+      for (const std::string& phase : phases())
         std::cout << std::left << std::setw(26) << phase << std::right << std::setw(16)
                   << 1e6 * coupled.at(phase) / (cells * steps) << std::setw(16) << 1e6 * fluid.at(phase) / (cells * steps)
                   << "\n";

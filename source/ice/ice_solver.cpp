@@ -60,6 +60,10 @@ constexpr double kFillMinimum = 1e-3;
 // at 0.14 s (doc/mpmice.md).
 constexpr double kPoreShareLow = 0.05;
 constexpr double kPoreShareHigh = 0.15;
+// With solids, the outer iterations of the pressure equation up to this one take the face
+// coefficient from the upwind side of each face velocity (Newton's step); later ones the larger of
+// the two sides' shares (carriedFaceBeta).
+constexpr int kNewtonOuterIterations = 4;
 
 // Gives every material of a cell that holds a negligible share of its mass the mixture's
 // (mass-weighted) velocity, so that its meaningless own value can neither limit the time step nor
@@ -513,19 +517,30 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
 
 // [5] With solids in the cells, the pressure matrix's face coefficient β = Σ_m v_f,m θ_m with the
 // volume fraction θ_m that each material's flux carries (pressureRightHandSide): a fluid's from
-// fluidFaceFractions, a deformable solid's share of the face, none for a rigid body. Which side the
-// flux comes from is not known before the correction: the larger of the two, which never assumes
-// less response than the flux has, so that the outer iterations contract.
+// fluidFaceFractions, a deformable solid's share of the face, none for a rigid body. The flux of
+// material m through a face is w θ_m(side w comes from), with the fractions fixed for the step, so
+// its derivative with respect to w is the share on the upwind side of w: β takes that side of the
+// current face velocity (predicted before the first solve, corrected before the others), which
+// makes each outer iteration a Newton step of the piecewise linear fluxes. Where the side is not
+// known (w = 0), the larger of the two shares. On a face whose flow turns in a correction the
+// step takes the new side's share, which is exact once the flow stays on that side; should the
+// flows keep turning, from outer iteration kNewtonOuterIterations + 1 on every face takes the
+// larger of its two shares, which never assumes less response than the flux has, so that the
+// outer iterations contract (the rule used throughout before: by a factor ~0.44 per iteration on
+// the seed scene, whose bed's staircase of cut cells has fluid shares 0.25 and 0.75 in alternate
+// cells, where the matrix then took three times the response the flux had; doc/mpmice.md, "Cost").
 template <int Dim>
-void IceSolver<Dim>::carriedFaceBeta()
+void IceSolver<Dim>::carriedFaceBeta(int outer_iteration)
 {
   const int n = materials_;
   const auto neighbours = layout_->cellNeighbours();
   const auto roles = roles_;
+  const bool upwind = outer_iteration <= kNewtonOuterIterations;
   for (int d = 0; d < Dim; ++d) {
     const auto vf = face_specific_volume_.direction(d).view();
     const auto fluid = fluid_face_fraction_.direction(d).view();
     const auto share = solid_face_share_.direction(d).view();
+    const auto uf = face_velocity_.direction(d).view();
     auto beta = face_beta_.direction(d).view();
     Kokkos::parallel_for(
         "ice::carriedFaceBeta", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->overlapCells()),
@@ -537,7 +552,10 @@ void IceSolver<Dim>::carriedFaceBeta()
             const bool solid = roles.lagrangian[m];
             const double below = solid ? Kokkos::Experimental::fmin(1.0, share(c, 2 * m)) : fluid(c, 2 * m);
             const double above = solid ? Kokkos::Experimental::fmin(1.0, share(c, 2 * m + 1)) : fluid(c, 2 * m + 1);
-            b += vf(c, m) * Kokkos::Experimental::fmax(below, above);
+            const double w = uf(c, m);
+            // The side rule of pressureRightHandSide's flux: below when w > 0, else above.
+            const double carried = upwind && w != 0 ? (w > 0 ? below : above) : Kokkos::Experimental::fmax(below, above);
+            b += vf(c, m) * carried;
           }
           beta(c, 0) = b > 0 ? b : 0.0;
         });
@@ -1070,13 +1088,18 @@ void IceSolver<Dim>::pressurePhase(CellState<Dim>& state, double dt, IceStepRepo
   const bool implicit = settings_.pressure == "implicit";
   if (roles_.any_solid) {
     fluidFaceFractions(state, dt);
-    carriedFaceBeta();
+    carriedFaceBeta(1);
   }
   if (implicit) pressure_solver_->assemble(mixture_compressibility_, face_beta_, dt);
   double residual = pressureRightHandSide(state, dt, false);
   while (residual > settings_.outer_tolerance && report.outer_iterations < settings_.max_outer_iterations) {
     ++report.outer_iterations;
     if (implicit) {
+      // With solids the matrix follows the upwind sides of the corrected face velocities.
+      if (roles_.any_solid && report.outer_iterations > 1) {
+        carriedFaceBeta(report.outer_iterations);
+        pressure_solver_->assemble(mixture_compressibility_, face_beta_, dt);
+      }
       delta_p_.fill(0.0);
       // After this solve the right-hand side is the linear residual r plus the change of the
       // upwinded fluxes (the matrix uses mean face volume fractions). The outer test bounds

@@ -122,7 +122,10 @@ class IceSolver {
   /// materials, and energy (unless isothermal); the exchanged velocities become the state's.
   void exchangePhase(CellState<Dim>& state, double dt, IceStepReport& report);
   void filterOddEven(const CellState<Dim>& state);
-  void carriedFaceBeta();
+  /// [5] The pressure matrix's face coefficient with solids for the given outer iteration (from 1):
+  /// the derivative of the fluxes that pressureRightHandSide takes at the current face velocities
+  /// (see the definition).
+  void carriedFaceBeta(int outer_iteration);
   /// [10] Advection of the fluids (solids are Lagrangian) and the cell closure θ = ρ v.
   void advectionPhase(CellState<Dim>& state, double dt, IceStepReport& report);
 

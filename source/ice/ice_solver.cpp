@@ -1095,10 +1095,12 @@ void IceSolver<Dim>::pressurePhase(CellState<Dim>& state, double dt, IceStepRepo
   while (residual > settings_.outer_tolerance && report.outer_iterations < settings_.max_outer_iterations) {
     ++report.outer_iterations;
     if (implicit) {
-      // With solids the matrix follows the upwind sides of the corrected face velocities.
-      if (roles_.any_solid && report.outer_iterations > 1) {
-        carriedFaceBeta(report.outer_iterations);
-        pressure_solver_->assemble(mixture_compressibility_, face_beta_, dt);
+      // From the second outer iteration on the matrix follows, with solids, the upwind sides of
+      // the corrected face velocities, and the slope of the volume law where it has fallen.
+      if (report.outer_iterations > 1) {
+        const bool slope_fell = followCompressibility(state);
+        if (roles_.any_solid) carriedFaceBeta(report.outer_iterations);
+        if (roles_.any_solid || slope_fell) pressure_solver_->assemble(mixture_compressibility_, face_beta_, dt);
       }
       delta_p_.fill(0.0);
       // After this solve the right-hand side is the linear residual r plus the change of the
@@ -1146,8 +1148,6 @@ void IceSolver<Dim>::pressurePhase(CellState<Dim>& state, double dt, IceStepRepo
     }
     // p = p_eq + Σδp and the faces corrected with this iteration's δp, then the new residual.
     residual = pressureRightHandSide(state, dt, true);
-    if (residual > settings_.outer_tolerance && followCompressibility(state))
-      pressure_solver_->assemble(mixture_compressibility_, face_beta_, dt);
   }
   report.outer_residual = residual;
   report.converged = residual <= settings_.outer_tolerance || !implicit;

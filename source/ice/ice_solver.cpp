@@ -31,12 +31,11 @@ constexpr double kNegligibleVolumeShare = 1e-12;
 // The share of its volume a material loses to a pressure change, v_L = v (1 − s(κ Σδp)): x to
 // first order (Uintah's computeLagrangianSpecificVolume), but for a compression the isothermal
 // gas's x / (1 + x) (v_L = v / (1 + x)), which has the same value and slope at x = 0 and leaves the
-// volume positive. The
-// linear form makes a gas's volume negative once one step raises its pressure by more than γ times
-// itself: in the slide a trace of air (θ ~ 1e-9) in a cell the sand had just left did so at 0.465 s;
-// its negative volume then made room for water 11 % over its density in the pressure equation, the
-// pressure fell to zero and the run failed within 30 steps. Both the Lagrangian volumes and the
-// pressure equation's residual use it (the matrix keeps the slope at x = 0, Σθκ).
+// volume positive. The linear form makes a gas's volume negative once one step raises its pressure
+// by more than γ times itself: in the slide a trace of air (θ ~ 1e-9) in a cell the sand had just
+// left did so at 0.465 s; its negative volume then made room for water 11 % over its density in the
+// pressure equation, the pressure fell to zero and the run failed within 30 steps. Both the
+// Lagrangian volumes and the pressure equation's residual use it (its matrix: below).
 KOKKOS_INLINE_FUNCTION double volumeLoss(double x) { return x > 0 ? x / (1.0 + x) : x; }
 KOKKOS_INLINE_FUNCTION double volumeLossSlope(double x) { return x > 0 ? 1.0 / ((1.0 + x) * (1.0 + x)) : 1.0; }
 // The pressure matrix's Σθκ is the slope of that loss at Σδp = 0. Where a gas is compressed

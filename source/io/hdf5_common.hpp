@@ -5,11 +5,18 @@
 
 #include <hdf5.h>
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 #include <utility>
 
 namespace cfdmpm::io_detail {
+
+/// A root-group text attribute longer than this many bytes is stored by Hdf5Writer as the byte
+/// dataset kTextDatasetGroup + name instead (an object header holds at most 64 KiB of
+/// attributes); Hdf5Reader::attributeText reads either form.
+inline constexpr std::size_t kLargestTextAttribute = 16384;
+inline constexpr char kTextDatasetGroup[] = "/attributes/";
 
 /// An HDF5 identifier closed by its own close function when it goes out of scope.
 class H5Handle {

@@ -3,7 +3,6 @@
 #include "common/error.hpp"
 #include "io/collective.hpp"
 #include "io/hdf5_common.hpp"
-#include "io/hdf5_writer.hpp"
 
 #include <hdf5.h>
 
@@ -16,6 +15,7 @@ static_assert(std::is_same_v<hid_t, std::int64_t>, "Hdf5Reader keeps HDF5 ids as
 
 using io_detail::anyRank;
 using io_detail::H5Handle;
+using io_detail::kTextDatasetGroup;
 
 namespace {
 

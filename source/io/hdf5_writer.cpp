@@ -21,6 +21,8 @@ namespace {
 using io_detail::anyRank;
 using io_detail::checked;
 using io_detail::H5Handle;
+using io_detail::kLargestTextAttribute;
+using io_detail::kTextDatasetGroup;
 using io_detail::onRankZero;
 using io_detail::rankOf;
 

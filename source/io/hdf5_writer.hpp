@@ -49,11 +49,6 @@ struct WrittenField {
 };
 
 /// What one output step put on disk; identical on every rank.
-/// A root-group text attribute longer than this many bytes is stored as the byte dataset
-/// kTextDatasetGroup + name instead: an object header holds at most 64 KiB of attributes.
-inline constexpr std::size_t kLargestTextAttribute = 16384;
-inline constexpr char kTextDatasetGroup[] = "/attributes/";
-
 struct WrittenStep {
   std::string file;  // file name inside the output directory, e.g. "dam_000120.h5"
   long long step = 0;

@@ -1013,6 +1013,7 @@ MpmSpec readMpm(ParameterList& list)
   mpm.contact = list.get<bool>("contact");
   mpm.contact_friction = list.get<double>("contact_friction");
   mpm.velocity_damping = list.get<double>("velocity_damping");
+  mpm.face_layer = list.get<double>("face_layer");
   return mpm;
 }
 

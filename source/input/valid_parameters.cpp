@@ -214,6 +214,12 @@ void defineMpm(ParameterList& mpm)
   define(mpm, "velocity_damping", 0.0,
          "Mass-proportional damping of the node velocities, to reach a static state; 0 for dynamics.",
          atLeast(0, "1/s"));
+  define(mpm, "face_layer", 0.125,
+         "Width, in cells, of the layers on either side of a cell face in which a solid's cover of the face is "
+         "measured for the coupled pressure equation (doc/mpmice.md, \"A solid's share of a face\"): thin "
+         "layers move the solid across a face only once it is there (fewer pressure jumps ahead of a sliding "
+         "front; input/rzadkiewicz.yaml uses 1/128), h/8 suits a light body's added mass.",
+         between(0, true, 0.5, false));
 }
 
 void defineIce(ParameterList& ice)

@@ -683,9 +683,6 @@ struct CellOverlap {
   double lower_share_[Dim];
 };
 
-/// Width of the layers on either side of a cell face in which a solid's share of the face is
-/// measured, in cells (see MpmSolver::particlesToCells).
-constexpr double kFaceLayer = 0.125;
 
 }  // namespace
 
@@ -732,6 +729,7 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt)
   for (int d = 0; d < Dim; ++d)
     origin[d] = grid.lower()[d], spacing[d] = grid.spacing()[d], count[d] = grid.cells()[d];
   const double cell_volume = grid.cellVolume();
+  const double layer = options_.face_layer;
   const auto scatter = KOKKOS_LAMBDA(const int p)
   {
     const int m = material(p);
@@ -767,13 +765,13 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt)
       const LocalOrdinal c = cells(predicted.cell[k][0], predicted.cell[k][1], predicted.cell[k][2]);
       if (c >= 0) out(c, predictedVolumeColumn(nm, m)) += predicted.share[k] * Vp;
     }
-    // Face shares: the particle's volume in the layers of width kFaceLayer cells just below and
-    // just above each interior face its box reaches, per volume of the layer. A moving rigid body's
+    // Face shares: the particle's volume in the layers of width `layer` cells (MpmOptions::face_layer)
+    // just below and just above each interior face its box reaches, per volume of the layer. A moving rigid body's
     // instead (both sides alike): the share of the face itself that its box covers, averaged over
-    // the step as the box moves by Δt v. The layers count a surface within h/8 of a face as a
-    // partial cover, which is wrong both ways for a prescribed motion: behind a body that leaves a
-    // face (the top of a plunger moving down) the face stayed closed until the body was h/8 past
-    // it, so the room it left had no way in; ahead of a body that comes at a face, the fluid
+    // the step as the box moves by Δt v. The layers count a surface within a layer of a face as
+    // a partial cover, which is wrong both ways for a prescribed motion: behind a body that leaves
+    // a face (the top of a plunger moving down) the face stayed closed until the body was a layer
+    // past it, so the room it left had no way in; ahead of a body that comes at a face, the fluid
     // between them had to leave through the layer's open part, ever faster as the gap closed.
     // Averaged over the step, the open part is the time the face is open, and the fluid crosses it
     // at the body's speed either way.
@@ -813,12 +811,12 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt)
     }
     for (int d = 0; d < Dim; ++d) {
       const double lo = (xp[d] - lp[d] - origin[d]) / spacing[d], hi = (xp[d] + lp[d] - origin[d]) / spacing[d];
-      const double per_length = Vp / ((hi - lo) * kFaceLayer * cell_volume);
-      const long long first_face = -(long long)math::floor(kFaceLayer - lo), last_face = (long long)math::floor(hi + kFaceLayer);
+      const double per_length = Vp / ((hi - lo) * layer * cell_volume);
+      const long long first_face = -(long long)math::floor(layer - lo), last_face = (long long)math::floor(hi + layer);
       for (long long f = first_face; f <= last_face; ++f) {
         if (f < 1 || f > count[d] - 1) continue;  // domain faces are walls
-        const double below = math::max(0.0, math::min(hi, double(f)) - math::max(lo, f - kFaceLayer));
-        const double above = math::max(0.0, math::min(hi, f + kFaceLayer) - math::max(lo, double(f)));
+        const double below = math::max(0.0, math::min(hi, double(f)) - math::max(lo, f - layer));
+        const double above = math::max(0.0, math::min(hi, f + layer) - math::max(lo, double(f)));
         if (below > 0 || above > 0) addToFace(d, f, per_length, below, above);
       }
     }
@@ -1282,6 +1280,7 @@ MpmOptions optionsFromScene(const Scene& scene)
   options.contact = scene.mpm.contact;
   options.contact_friction = scene.mpm.contact_friction;
   options.velocity_damping = scene.mpm.velocity_damping;
+  options.face_layer = scene.mpm.face_layer;
   return options;
 }
 

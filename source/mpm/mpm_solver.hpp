@@ -63,6 +63,9 @@ struct MpmOptions {
   double velocity_damping = 0.0;
   /// Courant number of the time step; <= 0 takes the scene's time.cfl.
   double cfl = 0.0;
+  /// Width of the layers on either side of a cell face in which a solid's share of the face is
+  /// measured, in cells (particlesToCells; doc/mpmice.md, "A solid's share of a face").
+  double face_layer = 0.125;
 };
 
 /// The options the scene's `mpm` section asks for (its values were checked when it was read).
@@ -133,7 +136,8 @@ class MpmSolver {
   /// and the cell values change smoothly as particles cross cell faces. ṽ_p = Σ_i w_ip v*_i, the
   /// grid velocity after integrateGrid (a rigid particle's: its prescribed velocity). And each
   /// material's share of every interior cell face, on each side: its volume in the layer of width
-  /// h/8 just below (above) the face, per volume of the layer. A face inside a body is covered (1),
+  /// MpmOptions::face_layer just below (above) the face, per volume of the layer. A face inside a
+  /// body is covered (1),
   /// the face on a body's surface is covered on the body's side only, and a face that a front has
   /// not reached is not covered, however full the cell behind it: what crosses a face in a step is
   /// the share of the layer upstream of it (times u Δt), not the upstream cell's volume fraction.

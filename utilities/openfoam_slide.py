@@ -38,6 +38,9 @@ import sys
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import slide_profile  # noqa: E402  (the surface's definition, shared with cfdmpm's outputs)
+
 LOWER = (-2.02, -0.04)
 UPPER = (1.5, 2.0)
 STILL_LEVEL = 1.6
@@ -137,23 +140,6 @@ def cmd_init(case, h, samples=20):
         len(c), sand.sum() * h * h, 0.5 * (1.5 - 0.866) * (1.486 - 0.85), water.sum() * h * h))
 
 
-def surface(theta, x0, y0, h):
-    ny, nx = theta.shape
-    x = x0 + h * (np.arange(nx) + 0.5)
-    eta = np.full(nx, np.nan)
-    for i in range(nx):
-        wet = np.nonzero(theta[:, i] >= 0.5)[0]
-        if len(wet) == 0:
-            continue
-        j = wet[-1]
-        y = y0 + h * (j + 0.5)
-        if j + 1 < ny:
-            above = theta[j + 1, i]
-            y += h * (theta[j, i] - 0.5) / (theta[j, i] - above)
-        eta[i] = y - STILL_LEVEL
-    return x, eta
-
-
 def front(sand, x0, h):
     best = np.nan
     for row in sand:
@@ -197,7 +183,7 @@ def cmd_extract(case, h, out, note):
         s = read_internal(os.path.join(case, d, "alpha.sand"))
         water[j, i] = a
         sand[j, i] = s
-        x, eta = surface(water, LOWER[0], LOWER[1], h)
+        x, eta = slide_profile.water_surface(water, LOWER[0], LOWER[1], h, h, STILL_LEVEL)
         k_lo, k_hi = int(np.nanargmin(eta)), int(np.nanargmax(eta))
         rows += [(t, xx, ee) for xx, ee in zip(x, eta)]
         summary.append(dict(time=t, trough=eta[k_lo], trough_x=x[k_lo], crest=eta[k_hi], crest_x=x[k_hi],
@@ -301,8 +287,6 @@ def cmd_compare(path, other):
             runs[t] = dict(x=x, eta=eta, trough=eta[lo], trough_x=x[lo], crest=eta[hi], crest_x=x[hi],
                            front=np.nan)
     else:
-        sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-        import slide_profile
         args = argparse.Namespace(still_level=STILL_LEVEL, sand_index=1, densities=(1985.0, 999.8))
         runs = {round(r["time"], 6): r for r in slide_profile.profile(other, args)}
     print("%6s %9s | %9s %8s %9s %8s | %9s %8s %9s %8s" % (

@@ -19,7 +19,6 @@ import glob
 import os
 import sys
 
-import h5py
 import numpy as np
 
 
@@ -32,28 +31,39 @@ def read_outputs(directory):
     return files, rows
 
 
-def surface(f, still_level):
-    """x of the column centres and eta(x) (NaN where a column holds no crossing)."""
-    count = f["cells"].attrs["count_xyz"]
-    origin = f["cells"].attrs["origin_xyz"]
-    h = f["cells"].attrs["spacing_xyz"]
-    theta = f["cells/water/volume_fraction"][:]  # (ny, nx)
-    x = origin[0] + h[0] * (np.arange(count[0]) + 0.5)
-    eta = np.full(count[0], np.nan)
-    for i in range(count[0]):
+def water_surface(theta, x0, y0, hx, hy, still_level):
+    """x of the column centres and eta(x) of a water volume fraction theta (ny, nx) on cells of
+    hx by hy whose lower corner is (x0, y0): in each column the topmost cell with theta >= 1/2,
+    its centre moved towards the cell above by hy (theta_j - 1/2) / (theta_j - theta_above),
+    minus still_level (NaN where a column holds no such cell). utilities/openfoam_slide.py uses
+    it too, so that both solvers' surfaces are measured alike."""
+    ny, nx = theta.shape
+    x = x0 + hx * (np.arange(nx) + 0.5)
+    eta = np.full(nx, np.nan)
+    for i in range(nx):
         wet = np.nonzero(theta[:, i] >= 0.5)[0]
         if len(wet) == 0:
             continue
         j = wet[-1]
-        y = origin[1] + h[1] * (j + 0.5)
-        if j + 1 < count[1]:
+        y = y0 + hy * (j + 0.5)
+        if j + 1 < ny:
             above = theta[j + 1, i]
-            y += h[1] * (theta[j, i] - 0.5) / (theta[j, i] - above)
+            y += hy * (theta[j, i] - 0.5) / (theta[j, i] - above)
         eta[i] = y - still_level
     return x, eta
 
 
+def surface(f, still_level):
+    """x of the column centres and eta(x) of an output file (NaN where a column holds no crossing)."""
+    origin = f["cells"].attrs["origin_xyz"]
+    h = f["cells"].attrs["spacing_xyz"]
+    theta = f["cells/water/volume_fraction"][:]  # (ny, nx)
+    return water_surface(theta, origin[0], origin[1], h[0], h[1], still_level)
+
+
 def profile(directory, args):
+    import h5py  # only reading outputs needs it (openfoam_slide.py imports this module without)
+
     files, rows = read_outputs(directory)
     rho_s, rho_w = args.densities
     out = []

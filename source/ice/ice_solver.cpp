@@ -562,8 +562,8 @@ void IceSolver<Dim>::carriedFaceBeta(int outer_iteration)
 }
 
 // [5] Right-hand side of the pressure equation, −Δt Σ_faces A Σ_m θ_upwind,m u_f,m · n_out
-// − V Σ_m θ_m s(κ_m Σδp) (≈ V Σθκ Σδp; the outer-iteration residual form of Uintah's setupRHS), plus the solids' own change
-// of volume V Σ_s Δθ_s (solidVolumeChange); returns max |rhs| / V.
+// − V Σ_m θ_m s(κ_m Σδp) (≈ V Σθκ Σδp; the outer-iteration residual form of Uintah's setupRHS),
+// plus the solids' own change of volume V Σ_s Δθ_s (solidVolumeChange); returns max |rhs| / V.
 // after_solve: first apply the solve's δp, in the same pass: Σδp += δp, p = p_eq + Σδp, and every
 // face velocity u_f −= Δt v_f (δp_R − δp_L) / h (owned cells; the ghosts of p and Σδp are not read
 // before the momentum phase refreshes p). Each cell corrects its lower faces into a second array and

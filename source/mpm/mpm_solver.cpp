@@ -683,7 +683,6 @@ struct CellOverlap {
   double lower_share_[Dim];
 };
 
-
 }  // namespace
 
 template <int Dim>
@@ -765,16 +764,16 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt)
       const LocalOrdinal c = cells(predicted.cell[k][0], predicted.cell[k][1], predicted.cell[k][2]);
       if (c >= 0) out(c, predictedVolumeColumn(nm, m)) += predicted.share[k] * Vp;
     }
-    // Face shares: the particle's volume in the layers of width `layer` cells (MpmOptions::face_layer)
-    // just below and just above each interior face its box reaches, per volume of the layer. A moving rigid body's
-    // instead (both sides alike): the share of the face itself that its box covers, averaged over
-    // the step as the box moves by Δt v. The layers count a surface within a layer of a face as
-    // a partial cover, which is wrong both ways for a prescribed motion: behind a body that leaves
-    // a face (the top of a plunger moving down) the face stayed closed until the body was a layer
-    // past it, so the room it left had no way in; ahead of a body that comes at a face, the fluid
-    // between them had to leave through the layer's open part, ever faster as the gap closed.
-    // Averaged over the step, the open part is the time the face is open, and the fluid crosses it
-    // at the body's speed either way.
+    // Face shares: the particle's volume in the layers of width `layer` cells
+    // (MpmOptions::face_layer) just below and just above each interior face its box reaches, per
+    // volume of the layer. A moving rigid body's instead (both sides alike): the share of the face
+    // itself that its box covers, averaged over the step as the box moves by Δt v. The layers count
+    // a surface within a layer of a face as a partial cover, which is wrong both ways for a
+    // prescribed motion: behind a body that leaves a face (the top of a plunger moving down) the
+    // face stayed closed until the body was a layer past it, so the room it left had no way in;
+    // ahead of a body that comes at a face, the fluid between them had to leave through the layer's
+    // open part, ever faster as the gap closed. Averaged over the step, the open part is the time
+    // the face is open, and the fluid crosses it at the body's speed either way.
     // Adds scale × (below, above) to the face columns of the cells at face f of direction d, in
     // proportion to the particle's overlap w with each of them across d.
     const auto addToFace = [&](int d, long long f, double scale, double below, double above) {

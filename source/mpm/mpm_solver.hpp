@@ -137,10 +137,10 @@ class MpmSolver {
   /// grid velocity after integrateGrid (a rigid particle's: its prescribed velocity). And each
   /// material's share of every interior cell face, on each side: its volume in the layer of width
   /// MpmOptions::face_layer just below (above) the face, per volume of the layer. A face inside a
-  /// body is covered (1),
-  /// the face on a body's surface is covered on the body's side only, and a face that a front has
-  /// not reached is not covered, however full the cell behind it: what crosses a face in a step is
-  /// the share of the layer upstream of it (times u Δt), not the upstream cell's volume fraction.
+  /// body is covered (1), the face on a body's surface is covered on the body's side only, and a
+  /// face that a front has not reached is not covered, however full the cell behind it: what
+  /// crosses a face in a step is the share of the layer upstream of it (times u Δt), not the
+  /// upstream cell's volume fraction.
   /// Summed across ranks: the owned cells are complete, and so are the ghosts.
   /// With dt > 0 also the volume each material would have in every cell if each particle moved by
   /// Δt ṽ_p (predictedVolumeColumn): how the solids' volumes move in a step before the fluid

@@ -1112,7 +1112,10 @@ void IceSolver<Dim>::pressurePhase(CellState<Dim>& state, double dt, IceStepRepo
       const double residual_target = settings_.solver_tolerance_given
                                          ? 0.0
                                          : 0.5 * settings_.outer_tolerance * layout_->grid().cellVolume();
-      const PressureSolveReport solve = pressure_solver_->solve(rhs_, delta_p_, residual_target);
+      // The outer iteration's index is the solve's kind (PressureSolver::solve): a first solve and
+      // a correction solve are not alike enough to judge a reused hierarchy by each other.
+      const PressureSolveReport solve =
+          pressure_solver_->solve(rhs_, delta_p_, residual_target, report.outer_iterations - 1);
       report.linear_iterations += solve.iterations;
       if (!solve.converged) {
         std::ostringstream message;

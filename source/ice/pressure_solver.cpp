@@ -17,6 +17,7 @@
 #include <Tpetra_Vector.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -198,9 +199,10 @@ struct PressureSolver<Dim>::Impl {
   bool values_changed = false;  // since the preconditioner last saw the matrix
   bool rebuild_requested = false;
   int solves_since_setup = 0;
-  // CG iterations per decade of residual reduction of the last solve with a fresh hierarchy (0:
-  // none yet); a reused hierarchy that needs `reuse slowdown limit` times more is replaced.
-  double fresh_iterations_per_decade = 0;
+  // Per kind of solve (solve()'s kind): CG iterations per decade of residual reduction of the last
+  // solve of that kind with a fresh hierarchy (0: none yet); a reused hierarchy that needs `reuse
+  // slowdown limit` times more than that for a solve of the same kind is replaced.
+  std::array<double, PressureSolver<Dim>::kSolveKinds> fresh_iterations_per_decade{};
 
   void buildGraph();
   Teuchos::ParameterList mueluParameters() const;
@@ -555,7 +557,7 @@ void PressureSolver<Dim>::apply(const Field<Dim>& x, Field<Dim>& y) const
 }
 
 template <int Dim>
-PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>& solution, double residual_target)
+PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>& solution, double residual_target, int kind)
 {
   Impl& m = *impl_;
   if (!m.assembled) throw std::logic_error("PressureSolver::solve before assemble");
@@ -634,9 +636,9 @@ PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>
       report.relative_residual > 0 && report.relative_residual < 0.1) {
     const double per_decade = report.iterations / -std::log10(report.relative_residual);
     // (After a failed reuse the count includes the failed attempt: no reference until the next setup.)
-    if (report.preconditioner_rebuilt) m.fresh_iterations_per_decade = reused ? 0.0 : per_decade;
-    else if (s.reuse_slowdown_limit > 0 && m.fresh_iterations_per_decade > 0 &&
-             per_decade > s.reuse_slowdown_limit * m.fresh_iterations_per_decade)
+    double& fresh = m.fresh_iterations_per_decade[std::clamp(kind, 0, kSolveKinds - 1)];
+    if (report.preconditioner_rebuilt) fresh = reused ? 0.0 : per_decade;
+    else if (s.reuse_slowdown_limit > 0 && fresh > 0 && per_decade > s.reuse_slowdown_limit * fresh)
       m.rebuild_requested = true;
   }
 

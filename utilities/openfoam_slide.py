@@ -296,10 +296,7 @@ def cmd_compare(path, other):
             continue
         x, eta = np.array(data[t]).T
         r = runs[t]
-        valid = np.isfinite(r["eta"])
-        other = np.interp(x, r["x"][valid], r["eta"][valid], left=np.nan, right=np.nan)
-        both = np.isfinite(other) & np.isfinite(eta)
-        rms = np.sqrt(np.mean((eta[both] - other[both]) ** 2))
+        rms = slide_profile.eta_rms(x, eta, r["x"], r["eta"])
         lo, hi = int(np.nanargmin(eta)), int(np.nanargmax(eta))
         print("%6.3f %9.5f | %9.5f %8.3f %9.5f %8.3f | %9.5f %8.3f %9.5f %8.3f   front_2 %.4f" % (
             t, rms, eta[lo], x[lo], r["trough"], r["trough_x"], eta[hi], x[hi], r["crest"], r["crest_x"],

@@ -53,6 +53,15 @@ def water_surface(theta, x0, y0, hx, hy, still_level):
     return x, eta
 
 
+def eta_rms(x, eta, ref_x, ref_eta):
+    """RMS of eta - ref_eta over the columns x where both have a surface, the reference interpolated
+    linearly to x (the grids may differ); NaN where they share none."""
+    valid = np.isfinite(ref_eta)
+    ref = np.interp(x, ref_x[valid], ref_eta[valid], left=np.nan, right=np.nan)
+    both = np.isfinite(ref) & np.isfinite(eta)
+    return float(np.sqrt(np.mean((eta[both] - ref[both]) ** 2))) if both.any() else float("nan")
+
+
 def surface(f, still_level):
     """x of the column centres and eta(x) of an output file (NaN where a column holds no crossing)."""
     origin = f["cells"].attrs["origin_xyz"]
@@ -127,11 +136,7 @@ def main():
             ref = reference.get(round(r["time"], 6))
             if ref is None:
                 continue
-            # The reference's eta at this run's column centres (linear; the grids may differ).
-            valid = np.isfinite(ref["eta"])
-            ref_eta = np.interp(r["x"], ref["x"][valid], ref["eta"][valid], left=np.nan, right=np.nan)
-            both = np.isfinite(ref_eta) & np.isfinite(r["eta"])
-            rms = float(np.sqrt(np.mean((r["eta"][both] - ref_eta[both]) ** 2))) if both.any() else float("nan")
+            rms = eta_rms(r["x"], r["eta"], ref["x"], ref["eta"])
             print("%7.3f %10.5f %12.5f %12.4f %12.4f" % (r["time"], rms, r["trough"] - ref["trough"],
                                                         r["trough_x"] - ref["trough_x"], r["front"] - ref["front"]))
 

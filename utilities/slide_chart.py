@@ -214,7 +214,8 @@ def cmd_chart(a):
         ax.grid(True, which="both", alpha=0.3)
     axes[0].set_ylabel("RMS of eta - eta_ref [mm]")
     axes[0].legend(fontsize=8)
-    fig.suptitle("Submarine slide (Rzadkiewicz et al. 1997): free-surface error against cost; eta_ref: %s" % os.path.basename(a.reference))
+    fig.suptitle("Submarine slide (Rzadkiewicz et al. 1997): free-surface error against cost; eta_ref: %s"
+                 % os.path.basename(a.reference))
     fig.tight_layout()
     fig.savefig(a.png, dpi=110)
     print("slide_chart.py: wrote " + a.png)

@@ -405,13 +405,20 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
             ice::exchangeMomentumFC<N>(nm, dt, K, fl, fr, vl, vr, vel, sv);
             // A material absent on both sides has no weight in the exchange and would keep its own
             // acceleration (for air inside water, v_air ∇p ~ 800 g); it moves with the mixture
-            // instead, whose specific volume is β = Σ θ_f v_f (Σ θ_f = 1).
-            double b = 0, weight = 0, momentum = 0;
+            // instead: the mass-weighted mean of the present materials' face velocities, and the
+            // same mean of their specific volumes for the pressure correction, so that it keeps
+            // moving with them after every correction. (With the matrix's β = Σ θ_f v_f instead,
+            // which is smaller where a rigid body or a solid takes part of the face, a trace of
+            // air next to the bed's cut cells left at up to ~100 m/s when the equilibration
+            // pressure jumped by MPa: the correction that cancels such a jump then differed
+            // between the water and the trace, and the trace's outflux refused the step.)
+            double b = 0, weight = 0, momentum = 0, specific_volume = 0;
             for (int m = 0; m < nm; ++m) {
               if (roles.rigid[m]) continue;
               const double w = (tl[m] + tr[m]) / sv[m];
               weight += w;
               momentum += w * vel[m];
+              specific_volume += w * sv[m];
               b += 0.5 * (fl[m] + fr[m]) * sv[m];
             }
             // A rigid body closes its larger share of the face; the other materials flow through
@@ -424,6 +431,7 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
               if (roles.rigid[m]) closed += Kokkos::Experimental::fmax(fl[m], fr[m]);
             const double open = closed < 1.0 ? 1.0 - closed : 0.0;
             const double mixture = momentum / (weight + kTiny);
+            const double mixture_sv = weight > 0 ? specific_volume / weight : b;
             for (int m = 0; m < nm; ++m) {
               if (roles.rigid[m]) {
                 // Its own motion is all of it (solidVolumeChange holds it): the pressure equation's
@@ -437,7 +445,7 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
               const bool present = tl[m] + tr[m] > 2 * kNegligibleVolumeShare;
               if (with_solids && roles.lagrangian[m]) kinematic(c, m) = open * (present ? own[m] : mixture);
               uf(c, m) = open * (present ? vel[m] : mixture);
-              vf(c, m) = open * (present ? sv[m] : b);  // and follows the mixture's pressure correction
+              vf(c, m) = open * (present ? sv[m] : mixture_sv);  // and follows the mixture's pressure correction
             }
             beta(c, 0) = open * b;
           });

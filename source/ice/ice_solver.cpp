@@ -9,6 +9,7 @@
 #include <Teuchos_TimeMonitor.hpp>
 
 #include <cfloat>
+#include <climits>
 #include <optional>
 #include <cmath>
 #include <iomanip>
@@ -664,7 +665,9 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
           double compression = 0;  // Σ_m θ_m s(κ_m Σδp): the share of the cell the pressure change takes
           for (int m = 0; m < nm; ++m) compression += theta(c, m) * volumeLoss(kappa(c, m) * sum_dp(c, 0));
           rhs(c, 0) = volume * solid_change - dt * outflow - volume * compression;
-          const double a = Kokkos::Experimental::fabs(rhs(c, 0));
+          // A value that is not finite counts as infinite (a NaN would lose every comparison and
+          // vanish from the maximum), so that the outer iteration sees it and stops.
+          const double a = Kokkos::Experimental::isfinite(rhs(c, 0)) ? Kokkos::Experimental::fabs(rhs(c, 0)) : INFINITY;
           if (a > worst) worst = a;
         },
         Kokkos::Max<double>(local_max));
@@ -1099,7 +1102,9 @@ void IceSolver<Dim>::pressurePhase(CellState<Dim>& state, double dt, IceStepRepo
   }
   if (implicit) pressure_solver_->assemble(mixture_compressibility_, face_beta_, dt);
   double residual = pressureRightHandSide(state, dt, false);
-  while (residual > settings_.outer_tolerance && report.outer_iterations < settings_.max_outer_iterations) {
+  // A right-hand side that is not finite stops the iteration at once; the caller names its cause.
+  while (std::isfinite(residual) && residual > settings_.outer_tolerance &&
+         report.outer_iterations < settings_.max_outer_iterations) {
     ++report.outer_iterations;
     if (implicit) {
       // From the second outer iteration on the matrix follows, with solids, the upwind sides of
@@ -1161,6 +1166,22 @@ void IceSolver<Dim>::pressurePhase(CellState<Dim>& state, double dt, IceStepRepo
   }
   report.outer_residual = residual;
   report.converged = residual <= settings_.outer_tolerance || !implicit;
+  if (!std::isfinite(residual)) {
+    const auto rhs = rhs_.view();
+    const auto ijk = layout_->cellIndex();
+    const long long nx = layout_->grid().cells()[0], ny = layout_->grid().cells()[1];
+    long long local = LLONG_MAX, global = LLONG_MAX;
+    Kokkos::parallel_reduce(
+        "ice::firstNonFiniteRhs", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+        KOKKOS_LAMBDA(const LocalOrdinal c, long long& lowest) {
+          if (Kokkos::Experimental::isfinite(rhs(c, 0))) return;
+          const long long gid = ijk(c, 0) + nx * (ijk(c, 1) + (Dim == 3 ? ny * ijk(c, 2) : 0));
+          if (gid < lowest) lowest = gid;
+        },
+        Kokkos::Min<long long>(local));
+    Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_MIN, local, Teuchos::outArg(global));
+    report.first_nonfinite_pressure_cell = global == LLONG_MAX ? -1 : global;
+  }
 
 
 }

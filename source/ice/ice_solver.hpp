@@ -56,6 +56,9 @@ struct IceStepReport {
   int linear_iterations = 0;      // summed over the outer iterations
   double outer_residual = 0;      // max |rhs| / V at the end (a fraction of the cell volume)
   bool converged = true;          // the outer iteration reached outer_tolerance
+  // With outer_residual not finite: global id of the lowest cell whose pressure equation's
+  // right-hand side is not finite, or -1.
+  long long first_nonfinite_pressure_cell = -1;
   int equilibration_failures = 0; // cells whose equilibration pressure did not converge
   long long first_failed_equilibration = -1;  // global id of the lowest of them, or -1
   // Largest |p_eq − p| over the cells (Pa): how far the equilibration moved the pressure that the

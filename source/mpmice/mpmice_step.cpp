@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <cmath>
 #include <sstream>
 #include <stdexcept>
 
@@ -107,6 +108,21 @@ CoupledStepReport MpmIceStep<Dim>::step(CellState<Dim>& state, double dt)
       }
       ice_->faceVelocityPhase(state, dt);
       ice_->pressurePhase(state, dt, report.ice);
+      if (!std::isfinite(report.ice.outer_residual)) {
+        // The pressure equation met a value that is not finite. Its cell inputs (densities, volume
+        // fractions, specific volumes, velocities) are as the phase found them: the first one that
+        // is not finite names the cell and material; otherwise a face velocity or a solid's volume
+        // change is (left to spread, the solve makes every cell's pressure NaN, and the exchange
+        // then reported every cell, the first at (0, 0)).
+        checkFinite(state, false);
+        std::ostringstream message;
+        message << "coupled step: the pressure equation's right-hand side is not finite";
+        if (report.ice.first_nonfinite_pressure_cell >= 0)
+          message << " at " << cellName(report.ice.first_nonfinite_pressure_cell) << " (the lowest such cell)";
+        message << ", while every cell's density, volume fraction, specific volume and velocity is: a face "
+                   "velocity or a solid's volume change from its particles there is not (reduce the time step)";
+        throw StepFailure(message.str());
+      }
       ice_->momentumSourcePhase(state, dt);
     }
     // 8. Cell-centred exchange between all materials.
@@ -171,7 +187,7 @@ void MpmIceStep<Dim>::restoreState(CellState<Dim>& state)
 }
 
 template <int Dim>
-void MpmIceStep<Dim>::checkFinite(const CellState<Dim>& state) const
+void MpmIceStep<Dim>::checkFinite(const CellState<Dim>& state, bool with_pressure) const
 {
   // The lowest (global cell id, field, column) with a value that is not finite, as one key.
   constexpr long long kKeysPerCell = 256;  // 6 fields x at most 32 columns (8 materials x 3 components)
@@ -180,6 +196,7 @@ void MpmIceStep<Dim>::checkFinite(const CellState<Dim>& state) const
   const auto fields = state.fields();
   long long first = LLONG_MAX;
   for (std::size_t f = 0; f < fields.size(); ++f) {
+    if (!with_pressure && fields[f] == &state.pressure) continue;
     const auto v = fields[f]->view();
     const int columns = fields[f]->columns();
     const long long field_key = 32 * static_cast<long long>(f);

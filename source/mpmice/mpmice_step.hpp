@@ -79,8 +79,9 @@ class MpmIceStep {
   /// The solids' cell velocity change since cellsFromParticles, in the particle solver's columns.
   void velocityChange(const CellState<Dim>& state);
   /// [12] Throws StepFailure naming the first cell (lowest global id) or particle (lowest id), its
-  /// material and the quantity, if a value of the state or of a particle is not finite.
-  void checkFinite(const CellState<Dim>& state) const;
+  /// material and the quantity, if a value of the state or of a particle is not finite
+  /// (with_pressure false: the pressure is not looked at).
+  void checkFinite(const CellState<Dim>& state, bool with_pressure = true) const;
   /// "cell (i, j)" or "cell (i, j, k)" for a global cell id, for messages.
   std::string cellName(long long global_id) const;
 

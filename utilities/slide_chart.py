@@ -13,6 +13,7 @@ the chart and the pictures of doc/validation.md.
   chart               the log-log PNG of eta RMS error against wall time, one point per row of the runs
                       CSV, with OpenFOAM's runs (data/reference/openfoam-rzadkiewicz-*.csv, wall time
                       from its summary) measured against the same reference on the same axes.
+  table               the runs CSV as a Markdown table (heights in mm, positions in m), for doc/validation.md.
   picture H5          the slide and the wave of one output: the water volume fraction and the
                       particles coloured by speed (the bed's particles grey), as a PNG.
 
@@ -24,6 +25,7 @@ Wall times depend on the machine and its load; the table says on how many ranks 
 usage: utilities/slide_chart.py reference DIR LOG [--out CSV] [--note TEXT]
        utilities/slide_chart.py point DIR LOG --label L --options TEXT --commit C [--reference CSV] [--runs CSV]
        utilities/slide_chart.py chart [--runs CSV] [--reference CSV] [--png PNG]
+       utilities/slide_chart.py table [--runs CSV]
        utilities/slide_chart.py picture H5 [--png PNG]
 """
 import argparse
@@ -221,6 +223,30 @@ def cmd_chart(a):
     print("slide_chart.py: wrote " + a.png)
 
 
+def cmd_table(a):
+    """The runs CSV as the Markdown table of doc/validation.md (heights in mm, positions in m)."""
+    rows = list(csv.DictReader(l for l in open(a.runs) if not l.startswith("#")))
+
+    def mm(value):
+        return "%.1f" % (1000 * float(value)) if value else "-"
+
+    def m(value):
+        return "%.3f" % float(value) if value else "-"
+
+    print("| cells | option set | ranks | eta RMS 0.4 s | trough 0.4 s (x m) | crest 0.4 s | front 0.4 s m "
+          "| eta RMS 0.8 s | trough 0.8 s (x m) | crest 0.8 s | front 0.8 s m | wall s | steps (retried) "
+          "| Δt limiter | commit |")
+    print("|" + "---|" * 15)
+    for r in rows:
+        cells = []
+        for t in TIMES:
+            cells += [mm(r["eta_rms_%g" % t]), "%s (%s)" % (mm(r["trough_%g" % t]), m(r["trough_x_%g" % t])),
+                      mm(r["crest_%g" % t]), m(r["front_%g" % t])]
+        print("| %s mm | %s | %s | %s | %s | %s (%s) | %s | %s |" % (
+            r["cell_size_mm"], r["options"], r["ranks"], " | ".join(cells), r["wall_s"], r["steps"], r["retries"],
+            r["dt_limiter"], r["commit"]))
+
+
 def cmd_picture(path, png):
     import h5py
     import matplotlib
@@ -259,7 +285,7 @@ def cmd_picture(path, png):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("command", choices=["reference", "point", "chart", "picture"])
+    p.add_argument("command", choices=["reference", "point", "chart", "table", "picture"])
     p.add_argument("paths", nargs="*", help="reference/point: DIR LOG; picture: H5")
     p.add_argument("--out", default=REFERENCE, help="reference: the CSV written")
     p.add_argument("--note", default="", help="reference: a line for the CSV's header")
@@ -270,7 +296,7 @@ def main():
     p.add_argument("--commit", default="")
     p.add_argument("--png")
     a = p.parse_args()
-    needed = dict(reference=2, point=2, chart=0, picture=1)[a.command]
+    needed = dict(reference=2, point=2, chart=0, table=0, picture=1)[a.command]
     if len(a.paths) != needed:
         p.error("%s takes %d path(s), got %d" % (a.command, needed, len(a.paths)))
     if a.command == "reference":
@@ -279,6 +305,8 @@ def main():
         if not a.label or not a.commit:
             p.error("point needs --label and --commit")
         cmd_point(a.paths[0], a.paths[1], a)
+    elif a.command == "table":
+        cmd_table(a)
     elif a.command == "chart":
         a.png = a.png or os.path.join(ROOT, "doc", "img", "rzadkiewicz-speed-accuracy.png")
         cmd_chart(a)

@@ -36,6 +36,7 @@ import glob
 import os
 import re
 import sys
+import textwrap
 
 import numpy as np
 
@@ -119,7 +120,7 @@ def cmd_reference(directory, log, out, note):
             "# (UTC) from the run's outputs to t = %g s: %d steps (%d retried), the time step mostly\n"
             "# limited by %s, %d s of wall time on %d MPI rank(s) of the project's 2-core machine.%s\n" % (
                 h, datetime.datetime.utcnow().strftime("%Y-%m-%d"), runs[-1]["time"], steps, retries, limiter,
-                wall, ranks, ("\n# " + note) if note else ""))
+                wall, ranks, "".join("\n# " + line for line in textwrap.wrap(note, 98))))
         writer = csv.writer(handle)
         writer.writerow(["time", "x", "eta"])
         for r in runs:
@@ -189,10 +190,12 @@ def cmd_chart(a):
     reference = reference_profiles(a.reference)
     rows = list(csv.DictReader(l for l in open(a.runs) if not l.startswith("#")))
     foam = openfoam_points(reference)
-    fig, axes = plt.subplots(1, len(TIMES), figsize=(11, 4.4), sharey=True)
+    times = [t for t in TIMES if t in reference]  # a reference still running has not reached 0.8 s
+    fig, axes = plt.subplots(1, len(times), figsize=(5.5 * len(times) + 0.5, 4.4), sharey=True, squeeze=False)
+    axes = axes[0]
     option_sets = sorted({r["options"] for r in rows})
     markers = dict(zip(option_sets, "osD^v<>"))
-    for ax, t in zip(axes, TIMES):
+    for ax, t in zip(axes, times):
         for options in option_sets:
             own = sorted((r for r in rows if r["options"] == options), key=lambda r: float(r["wall_s"]))
             # The reference itself has no error, and a run that has not reached t has none yet.
@@ -216,8 +219,8 @@ def cmd_chart(a):
         ax.grid(True, which="both", alpha=0.3)
     axes[0].set_ylabel("RMS of eta - eta_ref [mm]")
     axes[0].legend(fontsize=8)
-    fig.suptitle("Submarine slide (Rzadkiewicz et al. 1997): free-surface error against cost; eta_ref: %s"
-                 % os.path.basename(a.reference))
+    fig.suptitle("Submarine slide (Rzadkiewicz et al. 1997): free-surface error against cost\neta_ref: %s"
+                 % os.path.basename(a.reference), fontsize=10)
     fig.tight_layout()
     fig.savefig(a.png, dpi=110)
     print("slide_chart.py: wrote " + a.png)

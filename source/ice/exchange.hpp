@@ -340,6 +340,16 @@ KOKKOS_INLINE_FUNCTION ExchangeStatus exchangeHeatCC(int count, double dt, const
   return status;
 }
 
+/// 2 a b / (a + b), the harmonic mean of two positive specific volumes, written so that it does not
+/// overflow: a solid's equation of state, evaluated in a cell that the solid does not fill, at a
+/// tension far beyond its range, gives ~1e308 (and 2 a overflows); then it is 2 / (1/a + 1/b), ~2 b.
+/// Below 1e150 the first form, bit for bit as before.
+KOKKOS_INLINE_FUNCTION double harmonicMean(double a, double b)
+{
+  if (a < 1e150 && b < 1e150) return 2.0 * a * b / (a + b);
+  return 2.0 / (1.0 / a + 1.0 / b);
+}
+
 /// Face momentum exchange (Uintah vel_FC_exchange; Kashiwa 2000 above eq. 4.13), in place, for the
 /// face-normal velocity of every material on one face between a left (L) and a right (R) cell.
 /// On the face, v_m = 2 v_L v_R/(v_L + v_R) (harmonic mean) and theta_m = (theta_L + theta_R)/2, so
@@ -366,7 +376,7 @@ KOKKOS_INLINE_FUNCTION ExchangeStatus exchangeMomentumFC(int count, double dt, c
   for (int m = 0; m < n; ++m) {
     const double vl = specific_volume_left[m];
     const double vr = specific_volume_right[m];
-    const double v = 2.0 * vl * vr / (vl + vr);
+    const double v = harmonicMean(vl, vr);
     const double theta = 0.5 * (volume_fraction_left[m] + volume_fraction_right[m]);
     system.volume_fraction[m] = theta;
     system.rate_scale[m] = v;

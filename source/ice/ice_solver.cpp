@@ -384,7 +384,7 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
               const double rl = rho(l, m), rr = rho(c, m);
               const double ul = u(l, m * Dim + d), ur = u(c, m * Dim + d);
               const double mean = (rl * ul + rr * ur) / (rl + rr + kTiny);
-              const double vbar = 2.0 * vl[m] * vr[m] / (vl[m] + vr[m]);
+              const double vbar = ice::harmonicMean(vl[m], vr[m]);
               // A solid's cell velocity already holds gravity and its stress (the MPM grid's v*).
               // A rigid body does not accelerate at all.
               vel[m] = roles.rigid[m]        ? mean

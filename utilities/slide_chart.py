@@ -14,6 +14,7 @@ the chart and the pictures of doc/validation.md.
                       CSV, with OpenFOAM's runs (data/reference/openfoam-rzadkiewicz-*.csv, wall time
                       from its summary) measured against the same reference on the same axes.
   table               the runs CSV as a Markdown table (heights in mm, positions in m), for doc/validation.md.
+  profiles [LABEL=DIR ...]  eta(x) side by side: the reference, cfdmpm runs, OpenFOAM's 10 and 5 mm runs.
   picture H5          the slide and the wave of one output: the water volume fraction and the
                       particles coloured by speed (the bed's particles grey), as a PNG.
 
@@ -26,6 +27,7 @@ usage: utilities/slide_chart.py reference DIR LOG [--out CSV] [--note TEXT]
        utilities/slide_chart.py point DIR LOG --label L --options TEXT --commit C [--reference CSV] [--runs CSV]
        utilities/slide_chart.py chart [--runs CSV] [--reference CSV] [--png PNG]
        utilities/slide_chart.py table [--runs CSV]
+       utilities/slide_chart.py profiles [LABEL=DIR ...] [--reference CSV] [--png PNG]
        utilities/slide_chart.py picture H5 [--png PNG]
 """
 import argparse
@@ -250,6 +252,41 @@ def cmd_table(a):
             r["dt_limiter"], r["commit"]))
 
 
+def cmd_profiles(a):
+    """eta(x) of the reference, of cfdmpm runs given as LABEL=DIR and of OpenFOAM's 10 and 5 mm runs,
+    one panel per time of TIMES that the reference has reached."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    reference = reference_profiles(a.reference)
+    times = [t for t in TIMES if t in reference]
+    curves = [("cfdmpm, reference (%s)" % os.path.basename(a.reference), reference, "k-")]
+    for item in a.paths:
+        label, directory = item.split("=", 1)
+        runs = {round(r["time"], 6): (r["x"], r["eta"]) for r in slide_profile.profile(directory, profile_args())}
+        curves.append(("cfdmpm, " + label, runs, "-"))
+    for h in (10, 5):
+        data = openfoam_slide.read_eta_csv(os.path.join(ROOT, "data", "reference", "openfoam-rzadkiewicz-%dmm.csv" % h))
+        curves.append(("OpenFOAM, %d mm" % h, {t: tuple(np.array(rows).T) for t, rows in data.items()}, "--"))
+    fig, axes = plt.subplots(len(times), 1, figsize=(10, 3.6 * len(times)), squeeze=False)
+    for ax, t in zip(axes[:, 0], times):
+        for label, data, style in curves:
+            if t in data:
+                x, eta = data[t]
+                ax.plot(x, 1000 * np.asarray(eta), style, label=label, linewidth=1.2)
+        ax.set_title("free surface at t = %g s" % t)
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("eta [mm]")
+        ax.set_xlim(-1.6, 1.5)
+        ax.grid(True, alpha=0.3)
+    axes[0, 0].legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(a.png, dpi=110)
+    print("slide_chart.py: wrote " + a.png)
+
+
 def cmd_picture(path, png):
     import h5py
     import matplotlib
@@ -288,8 +325,8 @@ def cmd_picture(path, png):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("command", choices=["reference", "point", "chart", "table", "picture"])
-    p.add_argument("paths", nargs="*", help="reference/point: DIR LOG; picture: H5")
+    p.add_argument("command", choices=["reference", "point", "chart", "table", "profiles", "picture"])
+    p.add_argument("paths", nargs="*", help="reference/point: DIR LOG; picture: H5; profiles: LABEL=DIR ...")
     p.add_argument("--out", default=REFERENCE, help="reference: the CSV written")
     p.add_argument("--note", default="", help="reference: a line for the CSV's header")
     p.add_argument("--reference", default=REFERENCE)
@@ -299,8 +336,8 @@ def main():
     p.add_argument("--commit", default="")
     p.add_argument("--png")
     a = p.parse_args()
-    needed = dict(reference=2, point=2, chart=0, table=0, picture=1)[a.command]
-    if len(a.paths) != needed:
+    needed = dict(reference=2, point=2, chart=0, table=0, picture=1).get(a.command)
+    if needed is not None and len(a.paths) != needed:
         p.error("%s takes %d path(s), got %d" % (a.command, needed, len(a.paths)))
     if a.command == "reference":
         cmd_reference(a.paths[0], a.paths[1], a.out, a.note)
@@ -310,6 +347,9 @@ def main():
         cmd_point(a.paths[0], a.paths[1], a)
     elif a.command == "table":
         cmd_table(a)
+    elif a.command == "profiles":
+        a.png = a.png or os.path.join(ROOT, "doc", "img", "rzadkiewicz-profiles.png")
+        cmd_profiles(a)
     elif a.command == "chart":
         a.png = a.png or os.path.join(ROOT, "doc", "img", "rzadkiewicz-speed-accuracy.png")
         cmd_chart(a)

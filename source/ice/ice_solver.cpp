@@ -354,8 +354,8 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
   const auto theta = state.volume_fraction.view();
   const auto v = state.specific_volume.view();
   const auto p = state.pressure.view();
-  const auto K = pairCoefficients(settings_.exchange_coefficient, n, roles_, true);
-  const auto roles = roles_;
+  const auto roles = faceRoles();
+  const auto K = pairCoefficients(settings_.exchange_coefficient, n, roles, true);
   const bool with_solids = roles_.any_solid;
   forMaterialCount(n, [&](auto count) {
     constexpr int N = decltype(count)::value;
@@ -542,7 +542,7 @@ void IceSolver<Dim>::carriedFaceBeta(int outer_iteration)
 {
   const int n = materials_;
   const auto neighbours = layout_->cellNeighbours();
-  const auto roles = roles_;
+  const auto roles = faceRoles();
   const bool upwind = outer_iteration <= kNewtonOuterIterations;
   for (int d = 0; d < Dim; ++d) {
     const auto vf = face_specific_volume_.direction(d).view();
@@ -599,7 +599,7 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
   typename Field<Dim>::ConstView uf[3], vf[3], share[3], fluid[3], kinematic[3];
   const auto solid_change_view = solid_volume_change_.view();
   typename Field<Dim>::View corrected[3];
-  const auto roles = roles_;
+  const auto roles = faceRoles();
   for (int d = 0; d < Dim; ++d) {
     share[d] = solid_face_share_.direction(d).view();
     fluid[d] = fluid_face_fraction_.direction(d).view();

@@ -161,6 +161,14 @@ class IceSolver {
   /// A solid's volume moves as its particles move, which near a contact or along a staircase
   /// surface is not the cell-averaged velocity times a face share.
   Field<Dim>& solidVolumeChange() { return solid_volume_change_; }
+  /// Kinematic solids (the staggered coupling, mpm.coupling: staggered): the deformable solids'
+  /// motion over the step is fixed before the pressure (solidVolumeChange holds all of it), so on
+  /// faces and in the pressure equation they are treated as a moving rigid body is: each closes
+  /// its share of a face, the fluids flow through the rest, and it takes no pressure correction.
+  /// The momentum sources and the cell-centred exchange still act on them, and their velocity
+  /// change reaches the particles' velocities (their positions the next step). Off by default: the
+  /// monolithic coupling, where the solids' response to the pressure is in the pressure equation.
+  void setKinematicSolids(bool on) { kinematic_solids_ = on; }
 
   /// The largest stable Δt for the state (convective CFL and viscous limits), at most
   /// growth × previous_dt and within [dt_min, dt_max].
@@ -194,6 +202,16 @@ class IceSolver {
   std::shared_ptr<const Layout<Dim>> layout_;
   int materials_;
   MaterialRoles roles_;
+  bool kinematic_solids_ = false;
+  /// The roles of the face phases (face velocities and exchange, the pressure equation): roles_,
+  /// with every solid rigid there when the solids are kinematic (setKinematicSolids).
+  MaterialRoles faceRoles() const
+  {
+    MaterialRoles roles = roles_;
+    if (kinematic_solids_)
+      for (int m = 0; m < ice::kMaxMaterials; ++m) roles.rigid[m] = roles.rigid[m] || roles.lagrangian[m];
+    return roles;
+  }
   ice::MaterialArray<ice::Eos> eos_;
   ice::MaterialArray<double> bulk_modulus_;  // solids: K of their equation of state (Pa)
   ice::MaterialArray<double> viscosity_;

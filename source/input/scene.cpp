@@ -1014,6 +1014,7 @@ MpmSpec readMpm(ParameterList& list)
   mpm.contact_friction = list.get<double>("contact_friction");
   mpm.velocity_damping = list.get<double>("velocity_damping");
   mpm.face_layer = list.get<double>("face_layer");
+  mpm.coupling = list.get<std::string>("coupling");
   return mpm;
 }
 

@@ -88,6 +88,7 @@ struct MpmSpec {
   double contact_friction = 0.0;        // Coulomb coefficient between solid materials
   double velocity_damping = 0.0;        // 1/s
   double face_layer = 0.125;            // cells: layer in which a solid's cover of a face is measured
+  std::string coupling = "monolithic";  // monolithic | staggered (fluid-solid pressure coupling)
 };
 
 struct Scene {

@@ -220,6 +220,12 @@ void defineMpm(ParameterList& mpm)
          "layers move the solid across a face only once it is there (fewer pressure jumps ahead of a sliding "
          "front; input/rzadkiewicz.yaml uses 1/128), h/8 suits a light body's added mass.",
          between(0, true, 0.5, false));
+  define(mpm, "coupling", std::string("monolithic"),
+         "How the solids meet the fluids' pressure: `monolithic` (their response to it is in the pressure "
+         "equation) or `staggered` (their motion over a step is fixed before the pressure, which acts on them "
+         "the next step: for comparison only, unstable for solids lighter than the fluid; doc/stability.md, "
+         "case b).",
+         oneOf({"monolithic", "staggered"}));
 }
 
 void defineIce(ParameterList& ice)

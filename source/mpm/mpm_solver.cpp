@@ -557,6 +557,9 @@ void MpmSolver<Dim>::gridToParticlesWith(double dt)
         });
   }
   const auto node_u = remap ? node_velocity_new_->view() : node_vs;
+  // The velocity the particles move with: v*, or with the staggered coupling v* before the coupled
+  // step's change (the motion the fluids' pressure equation was given).
+  const auto node_moved = options_.move_before_coupling && node_velocity_moved_ ? node_velocity_moved_->view() : node_vs;
 
   Kokkos::parallel_for(
       "mpm::grid_to_particles", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count), KOKKOS_LAMBDA(const int p) {
@@ -573,7 +576,7 @@ void MpmSolver<Dim>::gridToParticlesWith(double dt)
         for (int d = 0; d < Dim; ++d) xp[d] = x(p, d), lp[d] = half_width(p, d);
         ShapeStencil<Dim, Kernel> s;
         evaluateShape(xp, origin, spacing, lp, s);
-        double v_grid[Dim] = {}, dv[Dim] = {};
+        double v_grid[Dim] = {}, dv[Dim] = {}, v_moved[Dim] = {};
         Mat<Dim> grad_v;
         for (int k = 0; k < s.size; ++k) {
           long long node[3] = {0, 0, 0};
@@ -584,6 +587,7 @@ void MpmSolver<Dim>::gridToParticlesWith(double dt)
           for (int d = 0; d < Dim; ++d) {
             const double vs = node_vs(lid, m * Dim + d);
             v_grid[d] += w * vs;
+            v_moved[d] += w * node_moved(lid, m * Dim + d);
             dv[d] += w * (vs - node_v(lid, m * Dim + d));
             const double u = node_u(lid, m * Dim + d);
             for (int e = 0; e < Dim; ++e) grad_v(d, e) += u * s.gradient[k][e];
@@ -592,7 +596,7 @@ void MpmSolver<Dim>::gridToParticlesWith(double dt)
         Mat<Dim> Fp;
         for (int d = 0; d < Dim; ++d) {
           if (!remap) v(p, d) = flip * (v(p, d) + dv[d]) + (1.0 - flip) * v_grid[d];
-          x(p, d) += dt * v_grid[d];
+          x(p, d) += dt * v_moved[d];
           for (int e = 0; e < Dim; ++e) {
             L(p, d, e) = grad_v(d, e);
             Fp(d, e) = F(p, d, e);
@@ -835,6 +839,12 @@ void MpmSolver<Dim>::addCellVelocityChangeWith(const Field<Dim>& change)
     node_momentum_change_ =
         std::make_unique<Field<Dim>>(layout_, Location::Node, std::max(1, nm) * Dim, "mpm node momentum change");
   node_momentum_change_->fill(0.0);
+  if (options_.move_before_coupling) {
+    if (!node_velocity_moved_)
+      node_velocity_moved_ = std::make_unique<Field<Dim>>(layout_, Location::Node, node_velocity_star_->columns(),
+                                                          "mpm node velocity the particles move with");
+    Kokkos::deep_copy(node_velocity_moved_->view(), node_velocity_star_->view());
+  }
   const Grid<Dim>& grid = layout_->grid();
   const MaterialTable table = materialTable(materials_);
   const NodeColumns col{std::max(1, nm), Dim};
@@ -1280,6 +1290,7 @@ MpmOptions optionsFromScene(const Scene& scene)
   options.contact_friction = scene.mpm.contact_friction;
   options.velocity_damping = scene.mpm.velocity_damping;
   options.face_layer = scene.mpm.face_layer;
+  options.move_before_coupling = scene.mpm.coupling == "staggered";
   return options;
 }
 

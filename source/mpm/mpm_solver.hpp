@@ -66,6 +66,10 @@ struct MpmOptions {
   /// Width of the layers on either side of a cell face in which a solid's share of the face is
   /// measured, in cells (particlesToCells; doc/mpmice.md, "A solid's share of a face").
   double face_layer = 0.125;
+  /// Staggered coupling (mpm.coupling: staggered): the particles move with their grid velocity
+  /// before the coupled step's velocity change (addCellVelocityChange), which reaches only their
+  /// velocities; their motion is then the one the fluids' pressure equation was given.
+  bool move_before_coupling = false;
 };
 
 /// The options the scene's `mpm` section asks for (its values were checked when it was read).
@@ -243,6 +247,7 @@ class MpmSolver {
   std::unique_ptr<Field<Dim>> node_velocity_new_;   // MUSL: updated particle momenta mapped back
   std::unique_ptr<Field<Dim>> node_constraint_;     // MUSL: per material, how v* was held (ConstraintKind)
   std::unique_ptr<Field<Dim>> node_momentum_change_;  // coupled step: Σ_p w_ip m_p Δv_p
+  std::unique_ptr<Field<Dim>> node_velocity_moved_;   // staggered coupling: v* before the coupled change
   // With more than one thread, the particle-to-node scatters run tile colour by tile colour
   // (ParticleBins); the bins of P2G hold until G2P moves the particles.
   ParticleBins<Dim> bins_;

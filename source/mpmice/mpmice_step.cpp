@@ -39,6 +39,7 @@ MpmIceStep<Dim>::MpmIceStep(const Scene& scene, std::shared_ptr<const Layout<Dim
         solids.push_back(SolidProperties{s.scene_index, s.bulk_modulus, s.density, s.rigid});
     ice_ = std::make_unique<IceSolver<Dim>>(scene, layout_, solids);
     ice_->setSolidReferencePressure(state.pressure);
+    ice_->setKinematicSolids(scene.mpm.coupling == "staggered");
   }
   if (ice_ && mpm_) {
     // The solids' share of every cell is that of their particles' GIMP domains; the fluids fill the

@@ -1,0 +1,129 @@
+// Stability case (b) (doc/stability.md, issue 14): the added-mass instability of a partitioned
+// fluid-solid coupling. A circular disk released from rest in still water accelerates at
+// a = g (ρs − ρw) / (ρs + ρw): potential flow gives a circular cylinder an added mass equal to the
+// water it displaces, m_a = ρw V. A staggered coupling (mpm.coupling: staggered) fixes the disk's
+// motion over a step before the pressure and lets the pressure act on it a step later; the
+// pressure's reaction to the disk's acceleration (−m_a a) then comes a step late, so each step's
+// acceleration error is the last one's times −m_a / m_s = −ρw / ρs, which grows for a disk lighter
+// than the water (Causin, Gerbeau & Nobile 2005, for the same ratio in a pipe). The monolithic
+// coupling (the default) has the disk's response to the pressure inside the pressure equation.
+#include "stability_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+namespace cfdmpm::test {
+namespace {
+
+Teuchos::RCP<const Teuchos::Comm<int>> world() { return Teuchos::DefaultComm<int>::getComm(); }
+
+bool rank0() { return world()->getRank() == 0; }
+
+struct DiskOutcome {
+  double ratio = 0;        // fitted acceleration / potential flow's
+  double oscillation = 0;  // RMS of the mean velocity about the fitted line / (|a| × 20 ms)
+  double growth = 0;       // that RMS over the window's second half / over its first half
+  std::string failure;     // what stopped the run, if it stopped
+};
+
+// The disk of test_coupled's added-mass case (0.05 m across, 20 cells per diameter, E = 1e6 Pa, a
+// tank ten diameters across and deep, no exchange: potential flow slips), released from rest. The
+// acceleration is the least-squares slope of the disk's mean vertical velocity over [5, 20] ms.
+DiskOutcome runDisk(double density, const std::string& coupling)
+{
+  const double diameter = 0.05, tank = 10 * diameter;
+  const long long cells = 200;
+  char disk[400];
+  std::snprintf(disk, sizeof disk,
+                "    disk:\n      kind: solid\n      density: %.6g\n      particles_per_cell: 2\n"
+                "      model: {type: linear_elastic, youngs_modulus: 1.0e6, poisson_ratio: 0.3}\n",
+                density);
+  const std::string regions = "    d: {material: disk, shape: polygon, vertices: " +
+                              diskVertices(tank / 2, tank / 2, diameter / 2, 96) + "}";
+  std::string text = tankScene(tank, tank, cells, cells, tank, disk, regions,
+                               "  ice: {exchange_coefficient: 0.0}\n  mpm: {coupling: " + coupling + "}");
+  text.replace(text.find("patch_cells: [10, 10]"), 21, "patch_cells: [25, 25]");
+  DiskOutcome out;
+  const double expected = -9.81 * (density - 1000.0) / (density + 1000.0);
+  std::vector<double> times, speeds;
+  try {
+    CoupledRun<2> run(sceneFromYaml(text), world());
+    run.runUntil(0.02, [&] {
+      if (run.time < 0.005) return;
+      times.push_back(run.time);
+      speeds.push_back(run.meanParticleVelocity(0, 1));
+    });
+  } catch (const std::exception& e) {
+    out.failure = e.what();
+    return out;
+  }
+  const std::size_t n = times.size();
+  double st = 0, sv = 0, stt = 0, stv = 0;
+  for (std::size_t k = 0; k < n; ++k) st += times[k], sv += speeds[k], stt += times[k] * times[k], stv += times[k] * speeds[k];
+  const double slope = (n * stv - st * sv) / (n * stt - st * st), offset = (sv - slope * st) / n;
+  double first = 0, second = 0;
+  for (std::size_t k = 0; k < n; ++k) (k < n / 2 ? first : second) += std::pow(speeds[k] - (offset + slope * times[k]), 2);
+  out.ratio = slope / expected;
+  out.oscillation = std::sqrt((first + second) / n) / (std::abs(expected) * 0.02);
+  out.growth = std::sqrt(second / (n - n / 2)) / std::sqrt(first / (n / 2));
+  return out;
+}
+
+// A run holds when it does not stop and the velocity's departure from uniform acceleration does not
+// grow over the window: the staggered step multiplies an acceleration error by ρw / ρs per step,
+// so below ρs = ρw it grows by orders of magnitude within the window's ~1000 steps, while a stable
+// run's departure (the start-up's pressure waves, the disk's elastic ringing) stays or decays.
+// Bound: growth ≤ 2 between the window's halves.
+constexpr double kGrowthBound = 2.0;
+
+TEST(StabilityAddedMass, LightDiskMonolithicHoldsStaggeredFails)
+{
+  std::vector<SweepRow> rows;
+  double staggered_fails_below = 0;
+  for (const double density : {2000.0, 500.0, 100.0}) {
+    const double ratio = density / 1000.0;
+    for (const std::string coupling : {"monolithic", "staggered"}) {
+      const DiskOutcome d = runDisk(density, coupling);
+      const bool holds = d.failure.empty() && d.growth <= kGrowthBound;
+      if (rank0())
+        std::printf("disk %6.0f kg/m^3 (ρs/ρw %.3g), %-10s: a / potential flow %.4f, oscillation %.3g, growth %.3g%s%s\n",
+                    density, ratio, coupling.c_str(), d.ratio, d.oscillation, d.growth,
+                    d.failure.empty() ? "" : ", stopped: ", d.failure.c_str());
+      const double error = d.failure.empty() ? std::abs(d.ratio - 1.0) + d.oscillation : 10.0;
+      rows.push_back({ratio, error, coupling == "monolithic" ? "monolithic (cfdmpm)" : "staggered",
+                      holds ? "ok" : "failed"});
+      if (coupling == "monolithic") {
+        EXPECT_TRUE(holds) << density << ": growth " << d.growth << " " << d.failure;
+        // The issue's 10 % on the acceleration holds for the disks heavier than a fifth of the
+        // water (test_coupled's bound); the lighter disk's is reported (doc/stability.md, case b).
+        if (ratio >= 0.5) {
+          EXPECT_NEAR(d.ratio, 1.0, 0.10) << density;
+        }
+      } else {
+        if (!holds && staggered_fails_below == 0) staggered_fails_below = ratio;
+        // The staggered step holds for the heavy disk and fails for every disk lighter than the water.
+        if (ratio > 1.0) {
+          EXPECT_TRUE(holds) << density << ": growth " << d.growth << " " << d.failure;
+        } else {
+          EXPECT_FALSE(holds) << density;
+        }
+        // A run that stops says what failed: a cell or a particle.
+        const bool named = d.failure.find("cell (") != std::string::npos || d.failure.find("particle") != std::string::npos;
+        if (!d.failure.empty()) {
+          EXPECT_TRUE(named) << "a failure that names nothing: " << d.failure;
+        }
+      }
+    }
+  }
+  std::vector<std::pair<std::string, double>> thresholds;
+  if (staggered_fails_below > 0) thresholds.push_back({"staggered fails", staggered_fails_below});
+  writeSweep(*world(), "stability_b_added_mass", "density ratio solid / water",
+             "|a / potential flow - 1| + velocity oscillation (failed: 10)", rows, thresholds);
+}
+
+}  // namespace
+}  // namespace cfdmpm::test

@@ -1224,14 +1224,16 @@ void IceSolver<Dim>::advectionPhase(CellState<Dim>& state, double dt, IceStepRep
   Teuchos::TimeMonitor phase(*timers_.at("advection"));
   if (roles_.any_solid) {
     const int n = materials_;
-    const auto roles = roles_;
+    unsigned lagrangian = 0;  // bit m: material m is a solid
+    for (int m = 0; m < n; ++m)
+      if (roles_.lagrangian[m]) lagrangian |= 1u << m;
     for (int d = 0; d < Dim; ++d) {
       auto uf = face_velocity_.direction(d).view();
       Kokkos::parallel_for(
           "ice::holdSolids", Kokkos::RangePolicy<ExecutionSpace>(0, state.density.overlapCount()),
           KOKKOS_LAMBDA(const LocalOrdinal c) {
             for (int m = 0; m < n; ++m)
-              if (roles.lagrangian[m]) uf(c, m) = 0.0;
+              if (lagrangian >> m & 1u) uf(c, m) = 0.0;
           });
     }
   }

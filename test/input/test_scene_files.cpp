@@ -55,8 +55,8 @@ TEST(SceneFiles, RzadkiewiczSlideHasBedSandWaterAndAir)
 {
   const Scene scene = readScene((kInputDirectory / "rzadkiewicz.yaml").string());
   EXPECT_EQ(scene.domain.lower, (std::array<double, 3>{-2.02, -0.04, 0.0}));
-  EXPECT_EQ(scene.domain.upper, (std::array<double, 3>{1.5, 2.0, 1.0}));
-  EXPECT_EQ(scene.domain.cells, (std::array<long long, 3>{352, 204, 1}));  // cell_size: 10 mm
+  EXPECT_EQ(scene.domain.upper, (std::array<double, 3>{1.5, 1.8, 1.0}));
+  EXPECT_EQ(scene.domain.cells, (std::array<long long, 3>{352, 184, 1}));  // cell_size: 10 mm
   ASSERT_EQ(scene.materials.size(), 4u);
   EXPECT_EQ(scene.materials[scene.materialIndex("bed")].parameters.sublist("model").get<std::string>("type"), "rigid");
   const auto& sand = scene.materials[scene.materialIndex("sand")].parameters;

@@ -277,12 +277,12 @@ TEST_F(SceneTest, CellSizeGivesTheSameDomainAsCells)
 
 TEST_F(SceneTest, CellSizeDividesExtentsWithinRoundOff)
 {
-  // The seed scene's domain, 3.52 m x 2.04 m, at 40, 20, 10 and 5 mm: the extents (differences of
+  // The seed scene's domain, 3.52 m x 1.84 m, at 40, 20, 10 and 5 mm: the extents (differences of
   // doubles) divided by the size are whole numbers to within round-off.
   const std::string domain = replaced(replaced(kMinimalScene, "lower: [0, 0]", "lower: [-2.02, -0.04]"),
-                                      "upper: [1, 2]", "upper: [1.5, 2.0]");
+                                      "upper: [1, 2]", "upper: [1.5, 1.8]");
   const std::vector<std::pair<std::string, std::array<long long, 3>>> sizes{
-      {"0.04", {88, 51, 1}}, {"0.02", {176, 102, 1}}, {"0.01", {352, 204, 1}}, {"0.005", {704, 408, 1}}};
+      {"0.04", {88, 46, 1}}, {"0.02", {176, 92, 1}}, {"0.01", {352, 184, 1}}, {"0.005", {704, 368, 1}}};
   for (const auto& [size, cells] : sizes) {
     const Scene scene = readScene(write(replaced(domain, "cells: [40, 10]", "cell_size: " + size), size + ".yaml"));
     EXPECT_EQ(scene.domain.cells, cells) << "cell_size " << size;

@@ -86,7 +86,7 @@ def slide_sweep(work, failures):
             ("directory: output/rzadkiewicz", "directory: " + os.path.join(work, name)),
             ("    cell_size: 0.01 ", "    cell_size: 0.04 "),
             ("    end_time: 0.8", "    end_time: 0.4"),
-            ("    cfl: 0.25", "    cfl: %g" % cfl),
+            ("    cfl: 0.25\n", "    cfl: %g\n" % cfl),
             ("    interval: 0.05", "    interval: 0.4"),
         ], work, name)
         status, log, csv_rows = run(path, work, name)

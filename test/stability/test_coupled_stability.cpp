@@ -125,5 +125,28 @@ TEST(StabilityAddedMass, LightDiskMonolithicHoldsStaggeredFails)
              "|a / potential flow - 1| + velocity oscillation (failed: 10)", rows, thresholds);
 }
 
+// The issue's lightest disk, ρs = 10 kg/m³ (ρs/ρw = 0.01; potential flow: 0.98 g upwards, its own
+// inertia 1 % of the added mass), monolithic step only (the staggered one fails from 0.5 on). It
+// does not hold: measured on 2026-12-03 (~45 minutes on a loaded core), the run stops with the
+// cell-centred exchange not finite at cell (115, 101) (the disk started centred on (100, 100), 10
+// cells in radius; doc/stability.md,
+// case b). Disabled because of its cost; run it with
+// `test_coupled_stability --gtest_also_run_disabled_tests --gtest_filter='*Lightest*'`. It checks
+// what issue 14 asks of every failure: that it stops with the cell or particle named, and reports
+// the acceleration when the run holds.
+TEST(StabilityAddedMass, DISABLED_LightestDiskStopsNamedOrHolds)
+{
+  const DiskOutcome d = runDisk(10.0, "monolithic");
+  if (rank0())
+    std::printf("disk 10 kg/m^3 (ρs/ρw 0.01), monolithic: a / potential flow %.4f, oscillation %.3g, growth %.3g%s%s\n",
+                d.ratio, d.oscillation, d.growth, d.failure.empty() ? "" : ", stopped: ", d.failure.c_str());
+  if (d.failure.empty()) {
+    EXPECT_LE(d.growth, kGrowthBound);
+  } else {
+    const bool named = d.failure.find("cell (") != std::string::npos || d.failure.find("particle") != std::string::npos;
+    EXPECT_TRUE(named) << "a failure that names nothing: " << d.failure;
+  }
+}
+
 }  // namespace
 }  // namespace cfdmpm::test

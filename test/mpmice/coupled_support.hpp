@@ -58,6 +58,43 @@ inline std::string diskVertices(double cx, double cy, double radius, int n = 64)
   return out + "]";
 }
 
+/// The added-mass disk (test_coupled's case (c), stability case (b)): an elastic disk 0.05 m across
+/// (E = 1e6 Pa) of `density`, released from rest in the middle of a closed tank of water ten
+/// diameters across and deep (the walls add ~1 %: the image of a dipole at five diameters). No
+/// exchange: potential flow slips along the disk (K = 1e15 would hold the water of its boundary
+/// cells to it, a ring of ~h/2 that adds its mass). `mpm` is the scene's `mpm` section, if any
+/// (e.g. "{coupling: staggered}").
+inline std::string addedMassDiskScene(double density, int cells_per_diameter, const std::string& mpm = "")
+{
+  const double diameter = 0.05, tank = 10 * diameter;
+  const long long cells = 10 * cells_per_diameter;
+  const std::string disk = "    disk:\n      kind: solid\n      density: " + std::to_string(density) +
+                           "\n      particles_per_cell: 2\n"
+                           "      model: {type: linear_elastic, youngs_modulus: 1.0e6, poisson_ratio: 0.3}\n";
+  const std::string regions = "    d: {material: disk, shape: polygon, vertices: " +
+                              diskVertices(tank / 2, tank / 2, diameter / 2, 96) + "}";
+  std::string extra = "  ice: {exchange_coefficient: 0.0}";
+  if (!mpm.empty()) extra += "\n  mpm: " + mpm;
+  std::string text = tankScene(tank, tank, cells, cells, tank, disk, regions, extra);
+  text.replace(text.find("patch_cells: [10, 10]"), 21, "patch_cells: [25, 25]");
+  return text;
+}
+
+/// Least-squares line v = offset + slope t through the samples.
+struct LineFit {
+  double slope = 0, offset = 0;
+};
+inline LineFit fitLine(const std::vector<double>& t, const std::vector<double>& v)
+{
+  const double n = double(t.size());
+  double st = 0, sv = 0, stt = 0, stv = 0;
+  for (std::size_t k = 0; k < t.size(); ++k) st += t[k], sv += v[k], stt += t[k] * t[k], stv += t[k] * v[k];
+  LineFit fit;
+  fit.slope = (n * stv - st * sv) / (n * stt - st * st);
+  fit.offset = (sv - fit.slope * st) / n;
+  return fit;
+}
+
 /// The coupled step on a scene: layout, state, stepper, and a clock.
 template <int Dim>
 struct CoupledRun {
@@ -109,6 +146,17 @@ struct CoupledRun {
       if (mat(i) == a) sums[0] += m(i) * v(i, d), sums[1] += m(i);
     Teuchos::reduceAll(*layout->comm(), Teuchos::REDUCE_SUM, 2, sums, total);
     return total[0] / total[1];
+  }
+
+  /// The mean vertical velocity of MPM material a after every step from `from` to `to` (s), with the
+  /// times (a step that fails throws, as the stepper does).
+  void sampleMeanVerticalVelocity(int a, double from, double to, std::vector<double>& times, std::vector<double>& speeds)
+  {
+    runUntil(to, [&] {
+      if (time < from) return;
+      times.push_back(time);
+      speeds.push_back(meanParticleVelocity(a, Dim - 1));
+    });
   }
 
   /// Largest particle speed of MPM material a (collective).

@@ -138,29 +138,10 @@ TEST(CoupledStep, SandBlockRestsOnItsBuoyantWeight)
 // per diameter (the issue's), for a sinking (2000 kg/m^3) and a rising (500 kg/m^3) disk.
 double diskAcceleration(double density, int cells_per_diameter)
 {
-  const double diameter = 0.05, tank = 10 * diameter;
-  const long long cells = 10 * cells_per_diameter;
-  const std::string disk = withDensity(R"(    disk:
-      kind: solid
-      density: DENSITY
-      particles_per_cell: 2
-      model: {type: linear_elastic, youngs_modulus: 1.0e6, poisson_ratio: 0.3}
-)", density);
-  const std::string regions = "    d: {material: disk, shape: polygon, vertices: " +
-                              diskVertices(tank / 2, tank / 2, diameter / 2, 96) + "}";
-  // Potential flow slips along the disk: no exchange between the disk and the water (K = 1e15
-  // would hold the water of the disk's boundary cells to it, a ring of ~h/2 that adds its mass).
-  std::string text = tankScene(tank, tank, cells, cells, tank, disk, regions, "  ice: {exchange_coefficient: 0.0}");
-  text.replace(text.find("patch_cells: [10, 10]"), 21, "patch_cells: [25, 25]");
-  CoupledRun<2> run(sceneFromYaml(text), world());
-  // Least-squares slope of the mean vertical velocity against time over [5, 20] ms.
-  double n = 0, st = 0, sv = 0, stt = 0, stv = 0;
-  run.runUntil(0.02, [&] {
-    if (run.time < 0.005) return;
-    const double v = run.meanParticleVelocity(0, 1);
-    n += 1, st += run.time, sv += v, stt += run.time * run.time, stv += run.time * v;
-  });
-  return (n * stv - st * sv) / (n * stt - st * st);
+  CoupledRun<2> run(sceneFromYaml(addedMassDiskScene(density, cells_per_diameter)), world());
+  std::vector<double> times, speeds;
+  run.sampleMeanVerticalVelocity(0, 0.005, 0.02, times, speeds);
+  return fitLine(times, speeds).slope;
 }
 
 TEST(CoupledStep, DiskAcceleratesWithTheAddedMassOfPotentialFlow)

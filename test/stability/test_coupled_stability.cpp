@@ -30,47 +30,43 @@ struct DiskOutcome {
   std::string failure;     // what stopped the run, if it stopped
 };
 
-// The disk of test_coupled's added-mass case (0.05 m across, 20 cells per diameter, E = 1e6 Pa, a
-// tank ten diameters across and deep, no exchange: potential flow slips), released from rest. The
-// acceleration is the least-squares slope of the disk's mean vertical velocity over [5, 20] ms.
+// The disk of test_coupled's added-mass case (addedMassDiskScene: 20 cells per diameter, no
+// exchange) with the given coupling, released from rest. The acceleration is the least-squares slope
+// of the disk's mean vertical velocity over [5, 20] ms.
 DiskOutcome runDisk(double density, const std::string& coupling)
 {
-  const double diameter = 0.05, tank = 10 * diameter;
-  const long long cells = 200;
-  char disk[400];
-  std::snprintf(disk, sizeof disk,
-                "    disk:\n      kind: solid\n      density: %.6g\n      particles_per_cell: 2\n"
-                "      model: {type: linear_elastic, youngs_modulus: 1.0e6, poisson_ratio: 0.3}\n",
-                density);
-  const std::string regions = "    d: {material: disk, shape: polygon, vertices: " +
-                              diskVertices(tank / 2, tank / 2, diameter / 2, 96) + "}";
-  std::string text = tankScene(tank, tank, cells, cells, tank, disk, regions,
-                               "  ice: {exchange_coefficient: 0.0}\n  mpm: {coupling: " + coupling + "}");
-  text.replace(text.find("patch_cells: [10, 10]"), 21, "patch_cells: [25, 25]");
   DiskOutcome out;
   const double expected = -9.81 * (density - 1000.0) / (density + 1000.0);
   std::vector<double> times, speeds;
   try {
-    CoupledRun<2> run(sceneFromYaml(text), world());
-    run.runUntil(0.02, [&] {
-      if (run.time < 0.005) return;
-      times.push_back(run.time);
-      speeds.push_back(run.meanParticleVelocity(0, 1));
-    });
+    CoupledRun<2> run(sceneFromYaml(addedMassDiskScene(density, 20, "{coupling: " + coupling + "}")), world());
+    run.sampleMeanVerticalVelocity(0, 0.005, 0.02, times, speeds);
   } catch (const std::exception& e) {
     out.failure = e.what();
     return out;
   }
   const std::size_t n = times.size();
-  double st = 0, sv = 0, stt = 0, stv = 0;
-  for (std::size_t k = 0; k < n; ++k) st += times[k], sv += speeds[k], stt += times[k] * times[k], stv += times[k] * speeds[k];
-  const double slope = (n * stv - st * sv) / (n * stt - st * st), offset = (sv - slope * st) / n;
+  const LineFit fit = fitLine(times, speeds);
   double first = 0, second = 0;
-  for (std::size_t k = 0; k < n; ++k) (k < n / 2 ? first : second) += std::pow(speeds[k] - (offset + slope * times[k]), 2);
-  out.ratio = slope / expected;
+  for (std::size_t k = 0; k < n; ++k) (k < n / 2 ? first : second) += std::pow(speeds[k] - (fit.offset + fit.slope * times[k]), 2);
+  out.ratio = fit.slope / expected;
   out.oscillation = std::sqrt((first + second) / n) / (std::abs(expected) * 0.02);
   out.growth = std::sqrt(second / (n - n / 2)) / std::sqrt(first / (n / 2));
   return out;
+}
+
+void report(double density, const std::string& coupling, const DiskOutcome& d)
+{
+  if (rank0())
+    std::printf("disk %6.0f kg/m^3 (ρs/ρw %.3g), %-10s: a / potential flow %.4f, oscillation %.3g, growth %.3g%s%s\n",
+                density, density / 1000.0, coupling.c_str(), d.ratio, d.oscillation, d.growth,
+                d.failure.empty() ? "" : ", stopped: ", d.failure.c_str());
+}
+
+// A run that stops says what failed: a cell or a particle (issue 14, point 3).
+bool namesCellOrParticle(const std::string& failure)
+{
+  return failure.find("cell (") != std::string::npos || failure.find("particle") != std::string::npos;
 }
 
 // A run holds when it does not stop and the velocity's departure from uniform acceleration does not
@@ -89,10 +85,7 @@ TEST(StabilityAddedMass, LightDiskMonolithicHoldsStaggeredFails)
     for (const std::string coupling : {"monolithic", "staggered"}) {
       const DiskOutcome d = runDisk(density, coupling);
       const bool holds = d.failure.empty() && d.growth <= kGrowthBound;
-      if (rank0())
-        std::printf("disk %6.0f kg/m^3 (ρs/ρw %.3g), %-10s: a / potential flow %.4f, oscillation %.3g, growth %.3g%s%s\n",
-                    density, ratio, coupling.c_str(), d.ratio, d.oscillation, d.growth,
-                    d.failure.empty() ? "" : ", stopped: ", d.failure.c_str());
+      report(density, coupling, d);
       const double error = d.failure.empty() ? std::abs(d.ratio - 1.0) + d.oscillation : 10.0;
       rows.push_back({ratio, error, coupling == "monolithic" ? "monolithic (cfdmpm)" : "staggered",
                       holds ? "ok" : "failed"});
@@ -111,10 +104,8 @@ TEST(StabilityAddedMass, LightDiskMonolithicHoldsStaggeredFails)
         } else {
           EXPECT_FALSE(holds) << density;
         }
-        // A run that stops says what failed: a cell or a particle.
-        const bool named = d.failure.find("cell (") != std::string::npos || d.failure.find("particle") != std::string::npos;
         if (!d.failure.empty()) {
-          EXPECT_TRUE(named) << "a failure that names nothing: " << d.failure;
+          EXPECT_TRUE(namesCellOrParticle(d.failure)) << "a failure that names nothing: " << d.failure;
         }
       }
     }
@@ -129,22 +120,18 @@ TEST(StabilityAddedMass, LightDiskMonolithicHoldsStaggeredFails)
 // inertia 1 % of the added mass), monolithic step only (the staggered one fails from 0.5 on). It
 // does not hold: measured on 2026-12-03 (~45 minutes on a loaded core), the run stops with the
 // cell-centred exchange not finite at cell (115, 101) (the disk started centred on (100, 100), 10
-// cells in radius; doc/stability.md,
-// case b). Disabled because of its cost; run it with
+// cells in radius; doc/stability.md, case b). Disabled because of its cost; run it with
 // `test_coupled_stability --gtest_also_run_disabled_tests --gtest_filter='*Lightest*'`. It checks
 // what issue 14 asks of every failure: that it stops with the cell or particle named, and reports
 // the acceleration when the run holds.
 TEST(StabilityAddedMass, DISABLED_LightestDiskStopsNamedOrHolds)
 {
   const DiskOutcome d = runDisk(10.0, "monolithic");
-  if (rank0())
-    std::printf("disk 10 kg/m^3 (ρs/ρw 0.01), monolithic: a / potential flow %.4f, oscillation %.3g, growth %.3g%s%s\n",
-                d.ratio, d.oscillation, d.growth, d.failure.empty() ? "" : ", stopped: ", d.failure.c_str());
+  report(10.0, "monolithic", d);
   if (d.failure.empty()) {
     EXPECT_LE(d.growth, kGrowthBound);
   } else {
-    const bool named = d.failure.find("cell (") != std::string::npos || d.failure.find("particle") != std::string::npos;
-    EXPECT_TRUE(named) << "a failure that names nothing: " << d.failure;
+    EXPECT_TRUE(namesCellOrParticle(d.failure)) << "a failure that names nothing: " << d.failure;
   }
 }
 

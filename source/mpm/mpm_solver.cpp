@@ -558,8 +558,9 @@ void MpmSolver<Dim>::gridToParticlesWith(double dt)
   }
   const auto node_u = remap ? node_velocity_new_->view() : node_vs;
   // The velocity the particles move with: v*, or with the staggered coupling v* before the coupled
-  // step's change (the motion the fluids' pressure equation was given).
-  const auto node_moved = options_.move_before_coupling && node_velocity_moved_ ? node_velocity_moved_->view() : node_vs;
+  // step's change (the motion the fluids' pressure equation was given), gathered only then.
+  const bool moved_apart = options_.move_before_coupling && node_velocity_moved_;
+  const auto node_moved = moved_apart ? node_velocity_moved_->view() : node_vs;
 
   Kokkos::parallel_for(
       "mpm::grid_to_particles", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count), KOKKOS_LAMBDA(const int p) {
@@ -587,7 +588,7 @@ void MpmSolver<Dim>::gridToParticlesWith(double dt)
           for (int d = 0; d < Dim; ++d) {
             const double vs = node_vs(lid, m * Dim + d);
             v_grid[d] += w * vs;
-            v_moved[d] += w * node_moved(lid, m * Dim + d);
+            if (moved_apart) v_moved[d] += w * node_moved(lid, m * Dim + d);
             dv[d] += w * (vs - node_v(lid, m * Dim + d));
             const double u = node_u(lid, m * Dim + d);
             for (int e = 0; e < Dim; ++e) grad_v(d, e) += u * s.gradient[k][e];
@@ -596,7 +597,7 @@ void MpmSolver<Dim>::gridToParticlesWith(double dt)
         Mat<Dim> Fp;
         for (int d = 0; d < Dim; ++d) {
           if (!remap) v(p, d) = flip * (v(p, d) + dv[d]) + (1.0 - flip) * v_grid[d];
-          x(p, d) += dt * v_moved[d];
+          x(p, d) += dt * (moved_apart ? v_moved[d] : v_grid[d]);
           for (int e = 0; e < Dim; ++e) {
             L(p, d, e) = grad_v(d, e);
             Fp(d, e) = F(p, d, e);

@@ -220,8 +220,9 @@ TEST(MpmStability, UslMuslEnergyDrift)
       // at CFL 0.4 and 0.2, omega dt / 2 = 0.0196 and 0.0098). Bound: omega dt / 2 (1 + omega dt),
       // the second-order term doubled. For MUSL only: USL's range also holds its drift.
       const double omega_dt = 2 * kPi / (2 * kL / std::sqrt(kE / kRho)) * r.dt;
-      if (u == StressUpdate::ModifiedLast)
+      if (u == StressUpdate::ModifiedLast) {
         EXPECT_LT(std::max(r.energy_max / r.energy0 - 1, 1 - r.energy_min / r.energy0), omega_dt / 2 * (1 + omega_dt));
+      }
     }
   test::writeSweep(*Tpetra::getDefaultComm(), "stability_mpm_drift", "Courant number",
                    "|mean energy over the last period / over the first - 1|, 1000 steps", rows);

@@ -25,6 +25,7 @@
 #include <Teuchos_Time.hpp>
 
 #include <map>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -169,6 +170,17 @@ class IceSolver {
   /// change reaches the particles' velocities (their positions the next step). Off by default: the
   /// monolithic coupling, where the solids' response to the pressure is in the pressure equation.
   void setKinematicSolids(bool on) { kinematic_solids_ = on; }
+  /// The solids' volume from their particles (mpm.solid_volume: particles): before the first
+  /// pressure residual and after every correction, `predict(state, dt)` sets solidVolumeChange to
+  /// each solid's change of volume fraction over the step as its particles would make it with the
+  /// state's present pressure (its force, the exchange, the transfer to the particles), and the
+  /// pressure equation's residual counts that change alone (no face terms for the solids). Its
+  /// matrix leaves the deformable solids' faces out (their particles follow a pressure difference
+  /// across a face by ~10 % of what the face form says). Unset: the face form in both.
+  void setSolidVolumePredictor(std::function<void(CellState<Dim>&, double)> predict)
+  {
+    solid_volume_predictor_ = std::move(predict);
+  }
 
   /// The largest stable Δt for the state (convective CFL and viscous limits), at most
   /// growth × previous_dt and within [dt_min, dt_max].
@@ -203,6 +215,7 @@ class IceSolver {
   int materials_;
   MaterialRoles roles_;
   bool kinematic_solids_ = false;
+  std::function<void(CellState<Dim>&, double)> solid_volume_predictor_;  // setSolidVolumePredictor
   /// The roles of the face phases (face velocities and exchange, the pressure equation): roles_,
   /// with every solid rigid there when the solids are kinematic (setKinematicSolids).
   MaterialRoles faceRoles() const

@@ -1015,6 +1015,7 @@ MpmSpec readMpm(ParameterList& list)
   mpm.velocity_damping = list.get<double>("velocity_damping");
   mpm.face_layer = list.get<double>("face_layer");
   mpm.coupling = list.get<std::string>("coupling");
+  mpm.solid_volume = list.get<std::string>("solid_volume");
   return mpm;
 }
 

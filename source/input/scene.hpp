@@ -89,6 +89,7 @@ struct MpmSpec {
   double velocity_damping = 0.0;        // 1/s
   double face_layer = 0.125;            // cells: layer in which a solid's cover of a face is measured
   std::string coupling = "monolithic";  // monolithic | staggered (fluid-solid pressure coupling)
+  std::string solid_volume = "faces";   // faces | particles (the solids' volume change in the pressure equation)
 };
 
 struct Scene {

@@ -481,6 +481,15 @@ void checkSolverSettings(const Scene& scene)
                      "allowed: true in a scene with the solid material '" + first_solid +
                          "'; the coupled step does not carry the solids' temperature yet");
   }
+  if (scene.mpm.solid_volume == "particles" && scene.mpm.coupling != "monolithic") {
+    throw inputError("cfdmpm.mpm.solid_volume", "particles",
+                     "allowed with mpm.coupling: monolithic only (the staggered coupling fixes the solids' motion "
+                     "before the pressure); set solid_volume: faces or coupling: monolithic");
+  }
+  if (scene.mpm.solid_volume == "particles" && ice_runs && ice.get<std::string>("pressure") != "implicit") {
+    throw inputError("cfdmpm.mpm.solid_volume", "particles",
+                     "allowed with ice.pressure: implicit only (it acts in the implicit pressure's outer iterations)");
+  }
   if (solids > kMaxSolidMaterials) {
     throw inputError("cfdmpm.materials", std::to_string(solids) + " solid materials",
                      "the particle solver handles at most " + std::to_string(kMaxSolidMaterials));

@@ -704,7 +704,16 @@ void MpmSolver<Dim>::addCellVelocityChange(const Field<Dim>& change)
 {
   withShapeFunction([&](auto kernel) {
     using K = decltype(kernel);
-    addCellVelocityChangeWith<K>(change);
+    addCellVelocityChangeWith<K>(change, *node_velocity_star_, true);
+  });
+}
+
+template <int Dim>
+void MpmSolver<Dim>::predictCellVolumes(const Field<Dim>& change, double dt, Field<Dim>& volumes)
+{
+  withShapeFunction([&](auto kernel) {
+    using K = decltype(kernel);
+    predictCellVolumesWith<K>(change, dt, volumes);
   });
 }
 
@@ -833,14 +842,14 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt)
 
 template <int Dim>
 template <class Kernel>
-void MpmSolver<Dim>::addCellVelocityChangeWith(const Field<Dim>& change)
+void MpmSolver<Dim>::addCellVelocityChangeWith(const Field<Dim>& change, Field<Dim>& target, bool commit)
 {
   const int nm = int(materials_.size());
   if (!node_momentum_change_)
     node_momentum_change_ =
         std::make_unique<Field<Dim>>(layout_, Location::Node, std::max(1, nm) * Dim, "mpm node momentum change");
   node_momentum_change_->fill(0.0);
-  if (options_.move_before_coupling) {
+  if (commit && options_.move_before_coupling) {
     if (!node_velocity_moved_)
       node_velocity_moved_ = std::make_unique<Field<Dim>>(layout_, Location::Node, node_velocity_star_->columns(),
                                                           "mpm node velocity the particles move with");
@@ -889,8 +898,9 @@ void MpmSolver<Dim>::addCellVelocityChangeWith(const Field<Dim>& change)
 
   const GridConditions<Dim> conditions = gridConditions<Dim>(*layout_, materials_, options_, empty_node_mass_, wall_no_slip_);
   const auto sums = node_sums_->view();
-  auto velocity_star = node_velocity_star_->view();
-  const bool record = node_constraint_ != nullptr;  // only the MUSL re-map reads it
+  const auto velocity_star = node_velocity_star_->view();
+  auto velocity_out = target.view();
+  const bool record = commit && node_constraint_ != nullptr;  // only the MUSL re-map reads it
   auto constraint = record ? node_constraint_->view() : typename Field<Dim>::View();
   const double empty = empty_node_mass_;
   Kokkos::parallel_for(
@@ -910,9 +920,68 @@ void MpmSolver<Dim>::addCellVelocityChangeWith(const Field<Dim>& change)
         // the change pushes it in again, so it counts as held if either pass held it.
         for (int a = 0; a < nm; ++a) {
           if (record) constraint(i, a) = math::max(constraint(i, a), double(kind[a]));
-          for (int d = 0; d < Dim; ++d) velocity_star(i, a * Dim + d) = vs[a][d];
+          for (int d = 0; d < Dim; ++d) velocity_out(i, a * Dim + d) = vs[a][d];
         }
       });
+}
+
+template <int Dim>
+template <class Kernel>
+void MpmSolver<Dim>::predictCellVolumesWith(const Field<Dim>& change, double dt, Field<Dim>& volumes)
+{
+  const int nm = int(materials_.size());
+  if (volumes.columns() != nm)
+    throw std::invalid_argument("MpmSolver::predictCellVolumes: the cell field needs " + std::to_string(nm) + " columns");
+  if (!node_velocity_predicted_)
+    node_velocity_predicted_ = std::make_unique<Field<Dim>>(layout_, Location::Node, node_velocity_star_->columns(),
+                                                            "mpm node velocity of a predicted step");
+  addCellVelocityChangeWith<Kernel>(change, *node_velocity_predicted_, false);
+  volumes.fill(0.0);
+  const Grid<Dim>& grid = layout_->grid();
+  const MaterialTable table = materialTable(materials_);
+  const auto x = particles_.position;
+  const auto volume = particles_.volume;
+  const auto half_width = particles_.half_width;
+  const auto material = particles_.material;
+  const BoxLookup nodes = layout_->nodeLookup();
+  const BoxLookup cells = layout_->cellLookup();
+  const auto node_u = node_velocity_predicted_->view();
+  const auto out = volumes.view();
+  double origin[Dim], spacing[Dim];
+  long long count[Dim];
+  for (int d = 0; d < Dim; ++d)
+    origin[d] = grid.lower()[d], spacing[d] = grid.spacing()[d], count[d] = grid.cells()[d];
+  // The same position update as gridToParticlesWith (x_p += Δt Σ_i w_ip v_i, a rigid particle by
+  // its prescribed velocity), into the boxes of particlesToCellsWith.
+  const auto scatter = KOKKOS_LAMBDA(const int p)
+  {
+    const int m = material(p);
+    double xp[Dim], lp[Dim], velocity[Dim] = {};
+    for (int d = 0; d < Dim; ++d) xp[d] = x(p, d), lp[d] = half_width(p, d);
+    if (table.rigid[m]) {
+      for (int d = 0; d < Dim; ++d) velocity[d] = table.rigid_velocity[m][d];
+    } else {
+      ShapeStencil<Dim, Kernel> s;
+      evaluateShape(xp, origin, spacing, lp, s);
+      for (int k = 0; k < s.size; ++k) {
+        long long node[3] = {0, 0, 0};
+        s.node(k, node);
+        const LocalOrdinal lid = nodes(node[0], node[1], node[2]);
+        if (lid < 0) continue;
+        for (int d = 0; d < Dim; ++d) velocity[d] += s.weight[k] * node_u(lid, m * Dim + d);
+      }
+    }
+    double moved[Dim];
+    for (int d = 0; d < Dim; ++d) moved[d] = xp[d] + dt * velocity[d];
+    const CellOverlap<Dim> predicted(moved, lp, origin, spacing, count);
+    const double Vp = volume(p);
+    for (int k = 0; k < predicted.count; ++k) {
+      const LocalOrdinal c = cells(predicted.cell[k][0], predicted.cell[k][1], predicted.cell[k][2]);
+      if (c >= 0) out(c, m) += predicted.share[k] * Vp;
+    }
+  };
+  forEachParticleScattering("mpm::predict_cell_volumes", nodes, scatter);
+  volumes.sumToOwners();
 }
 
 /// The constitutive update, last in the step (USL or MUSL), with the velocity gradient of G2P. Dispatch on

@@ -156,6 +156,11 @@ class MpmSolver {
   /// then contact and the walls again. The momentum given to the nodes is Σ_c m_c Δu_c exactly (m_c
   /// the cell mass of particlesToCells). Rigid particles take no change.
   void addCellVelocityChange(const Field<Dim>& change);
+  /// Each material's volume in every cell (columns: materials; owned and ghost cells) after a G2P
+  /// with the grid velocity v* plus the cell velocity changes `change` (addCellVelocityChange's
+  /// columns and rules, walls and contact included), without changing the particles or v*: the
+  /// boxes of particlesToCells at x_p + Δt Σ_i w_ip v_i, with the particles' present volumes.
+  void predictCellVolumes(const Field<Dim>& change, double dt, Field<Dim>& volumes);
 
   // --- undoing a step (the driver retries a failed step with a smaller Δt) ------------------------
   /// The rank's particles, each row a particle's whole state in the order of Particles::pack.
@@ -221,8 +226,12 @@ class MpmSolver {
   void gridToParticlesWith(double dt);
   template <class Kernel>
   void particlesToCellsWith(Field<Dim>& sums, double dt);
+  // Writes v* + the change into `target` (node velocities); `commit`: the step's own change (the
+  // staggered coupling's copy of v* and MUSL's constraint record follow it), not a prediction.
   template <class Kernel>
-  void addCellVelocityChangeWith(const Field<Dim>& change);
+  void addCellVelocityChangeWith(const Field<Dim>& change, Field<Dim>& target, bool commit);
+  template <class Kernel>
+  void predictCellVolumesWith(const Field<Dim>& change, double dt, Field<Dim>& volumes);
   /// f(p) for every particle, for kernels that add into node arrays: in index order on one thread;
   /// on more, tile colour by tile colour (bins_, rebuilt when stale), so no two threads add into
   /// the same node.
@@ -248,6 +257,7 @@ class MpmSolver {
   std::unique_ptr<Field<Dim>> node_constraint_;     // MUSL: per material, how v* was held (ConstraintKind)
   std::unique_ptr<Field<Dim>> node_momentum_change_;  // coupled step: Σ_p w_ip m_p Δv_p
   std::unique_ptr<Field<Dim>> node_velocity_moved_;   // staggered coupling: v* before the coupled change
+  std::unique_ptr<Field<Dim>> node_velocity_predicted_;  // predictCellVolumes: v* + a trial change
   // With more than one thread, the particle-to-node scatters run tile colour by tile colour
   // (ParticleBins); the bins of P2G hold until G2P moves the particles.
   ParticleBins<Dim> bins_;

@@ -54,6 +54,12 @@ MpmIceStep<Dim>::MpmIceStep(const Scene& scene, std::shared_ptr<const Layout<Dim
     cellsFromParticles(state, 0.0);
     fillAroundSolids(scene, densityFunctions(scene), state);
   }
+  if (ice_ && mpm_ && scene.mpm.solid_volume == "particles") {
+    predicted_volume_ = std::make_unique<Field<Dim>>(layout_, Location::Cell, int(mpm_->materials().size()),
+                                                     "solid volume of a predicted step");
+    trial_state_ = std::make_unique<CellState<Dim>>(layout_, state.materials);
+    ice_->setSolidVolumePredictor([this](CellState<Dim>& s, double dt) { predictSolidVolumes(s, dt); });
+  }
   if (ice_) {
     const int failures = ice_->equilibrate(state);
     if (failures > 0)
@@ -280,6 +286,29 @@ void MpmIceStep<Dim>::cellsFromParticles(CellState<Dim>& state, double dt)
             solid_u(c, a * Dim + d) = velocity;
           }
         }
+      });
+}
+
+template <int Dim>
+void MpmIceStep<Dim>::predictSolidVolumes(const CellState<Dim>& state, double dt)
+{
+  trial_state_->assign(state);
+  IceStepReport ignored;  // the step's own exchange reports its failures
+  ice_->momentumSourcePhase(*trial_state_, dt);
+  ice_->exchangePhase(*trial_state_, dt, ignored);
+  velocityChange(*trial_state_);
+  mpm_->predictCellVolumes(*cell_change_, dt, *predicted_volume_);
+  const int nm = int(mpm_->materials().size());
+  Kokkos::Array<int, ice::kMaxMaterials> scene_index{};
+  for (int a = 0; a < nm; ++a) scene_index[a] = mpm_->materials()[a].scene_index;
+  const double volume = layout_->grid().cellVolume();
+  const auto sums = cell_sums_->view();
+  const auto predicted = predicted_volume_->view();
+  auto change = ice_->solidVolumeChange().view();
+  Kokkos::parallel_for(
+      "mpmice::predictSolidVolumes", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+      KOKKOS_LAMBDA(const LocalOrdinal c) {
+        for (int a = 0; a < nm; ++a) change(c, scene_index[a]) = (predicted(c, a) - sums(c, nm + a)) / volume;
       });
 }
 

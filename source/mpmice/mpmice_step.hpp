@@ -77,6 +77,10 @@ class MpmIceStep {
   /// The solids' columns of the state (mass density, volume fraction, velocity) from the particles.
   void cellsFromParticles(CellState<Dim>& state, double dt);
   /// The solids' cell velocity change since cellsFromParticles, in the particle solver's columns.
+  // The solids' volume change over the step as their particles make it with the state's present
+  // pressure (IceSolver::setSolidVolumePredictor): momentum sources and exchange on a copy of the
+  // state, their velocity change to the particles (MpmSolver::predictCellVolumes).
+  void predictSolidVolumes(const CellState<Dim>& state, double dt);
   void velocityChange(const CellState<Dim>& state);
   /// [12] Throws StepFailure naming the first cell (lowest global id) or particle (lowest id), its
   /// material and the quantity, if a value of the state or of a particle is not finite
@@ -92,6 +96,8 @@ class MpmIceStep {
   std::unique_ptr<Field<Dim>> cell_sums_;       // particlesToCells: mass, volume, momentum per solid
   std::unique_ptr<Field<Dim>> cell_change_;     // velocity change of the solids' cells (same columns)
   std::unique_ptr<Field<Dim>> solid_velocity_;  // the solids' cell velocity from the particles
+  std::unique_ptr<Field<Dim>> predicted_volume_;  // predictSolidVolumes: each solid's volume per cell
+  std::unique_ptr<CellState<Dim>> trial_state_;    // predictSolidVolumes: the state the trial phases change
   std::map<std::string, Teuchos::RCP<Teuchos::Time>> timers_;
   std::unique_ptr<CellState<Dim>> saved_state_;        // saveState's copy
   typename mpm::MpmSolver<Dim>::ParticleSnapshot saved_particles_;

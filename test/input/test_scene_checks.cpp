@@ -154,6 +154,20 @@ TEST_F(SceneTest, EnergyEquationWithSolidsIsRefusedWithTheScene)
   EXPECT_NO_THROW(readScene(write(replaced(fluidsOnly(kFullScene), kIce, "  ice: {isothermal: false}\n"))));
 }
 
+TEST_F(SceneTest, SolidVolumeFromParticlesNeedsTheMonolithicImplicitPressure)
+{
+  // The particles' trial moves run inside the implicit pressure's outer iterations, and the
+  // staggered coupling fixes the solids' motion before the pressure.
+  expectMentions(errorOf(replaced(kFullScene, "  mpm: {}\n", "  mpm: {solid_volume: particles, coupling: staggered}\n")),
+                 {"cfdmpm.mpm.solid_volume", "particles", "monolithic"});
+  expectMentions(errorOf(replaced(replaced(kFullScene, "  mpm: {}\n", "  mpm: {solid_volume: particles}\n"), kIce,
+                                  "  ice: {pressure: explicit}\n")),
+                 {"cfdmpm.mpm.solid_volume", "particles", "implicit"});
+  expectMentions(errorOf(replaced(kFullScene, "  mpm: {}\n", "  mpm: {solid_volume: nodes}\n")),
+                 {"cfdmpm.mpm.solid_volume", "nodes", "faces", "particles"});
+  EXPECT_NO_THROW(readScene(write(replaced(kFullScene, "  mpm: {}\n", "  mpm: {solid_volume: particles}\n"))));
+}
+
 TEST_F(SceneTest, HydrostaticWithGravityOffAxisIsRefusedWithTheScene)
 {
   std::string text = replaced(kFullScene, "hydrostatic: false", "hydrostatic: true");

@@ -81,7 +81,8 @@ TEST(CoupledStep, NeutrallyBuoyantBlockStaysPut)
 // 3 %: the sloshing's and the pore pressure's deviations at the base (±10 Pa measured inside the
 // block against the water beside it, 2 % of the 590 Pa buoyant weight there) and the air's
 // expansion (below).
-TEST(CoupledStep, SandBlockRestsOnItsBuoyantWeight)
+// extra_mpm: more keys of the wet run's mpm section.
+void expectSandBlockRestsOnItsBuoyantWeight(const std::string& extra_mpm)
 {
   const double rho_s = 2000.0, rho_w = 1000.0;
   const std::string block = "    b: {material: block, shape: box, lower: [0.05, 0.0], upper: [0.15, 0.06]}";
@@ -109,7 +110,7 @@ TEST(CoupledStep, SandBlockRestsOnItsBuoyantWeight)
   // the base), which the pore pressure inside the block, held at the still-water reference, does not
   // follow (doc/mpmice.md); under 0.35 m of air, as here, by 2 Pa (0.3 %).
   CoupledRun<2> run(sceneFromYaml(tankScene(0.2, 0.5, 20, 50, 0.15, withDensity(kElasticBlock, rho_s), block,
-                                            "  mpm: {velocity_damping: 100.0}")),
+                                            "  mpm: {velocity_damping: 100.0" + extra_mpm + "}")),
                     world());
   double stress_sum = 0, samples = 0, speed = 0;
   run.runUntil(0.4, [&] {
@@ -128,6 +129,15 @@ TEST(CoupledStep, SandBlockRestsOnItsBuoyantWeight)
   // At rest but for the sloshing: slower than a free fall over one damping time, g / α = 0.1 m/s,
   // by two orders of magnitude.
   EXPECT_LT(speed, 1e-3 * 9.81);
+}
+
+TEST(CoupledStep, SandBlockRestsOnItsBuoyantWeight) { expectSandBlockRestsOnItsBuoyantWeight(""); }
+
+// The same with the solids' volume from their particles (mpm.solid_volume: particles): the pressure
+// equation's view of the block changes, its load must not.
+TEST(CoupledStep, ParticleVolumesKeepTheBlocksBuoyantWeight)
+{
+  expectSandBlockRestsOnItsBuoyantWeight(", solid_volume: particles");
 }
 
 // (c) Added mass: a circular disk (a 2-D cylinder) released from rest in still water accelerates at
@@ -317,11 +327,12 @@ TEST(CoupledStep, FailedEquilibrationNamesTheCell)
 // scales (the tank's width; a full cell). Partitions change only the order of sums in the linear
 // solver and the reductions; with the solver's tolerance at 1e-14 the runs differ by round-off that
 // the 200 steps grow to well below that.
-TEST(CoupledStep, SameAnswerOnOneAndSeveralRanks)
+// extra: more scene options (the block sinks through the water; 200 steps).
+void expectSameAnswerOnOneAndSeveralRanks(const std::string& extra)
 {
   const Scene scene = sceneFromYaml(tankScene(0.2, 0.2, 20, 20, 0.15, withDensity(kElasticBlock, 1500.0),
                                               "    b: {material: block, shape: box, lower: [0.07, 0.08], upper: [0.13, 0.12]}",
-                                              "  ice: {solver_tolerance: 1.0e-14}"));
+                                              "  ice: {solver_tolerance: 1.0e-14}" + extra));
   const auto comm = world();
   struct Result {
     std::map<long long, std::array<double, 3>> positions;
@@ -362,6 +373,15 @@ TEST(CoupledStep, SameAnswerOnOneAndSeveralRanks)
               worst_fraction);
   EXPECT_LE(worst, 1e-8 * 0.2);
   EXPECT_LE(worst_fraction, 1e-8);
+}
+
+TEST(CoupledStep, SameAnswerOnOneAndSeveralRanks) { expectSameAnswerOnOneAndSeveralRanks(""); }
+
+// The solids' volume from their particles moved on a copy (mpm.solid_volume: particles): the trial
+// moves' boxes are summed over ranks like the step's own.
+TEST(CoupledStep, SameAnswerOnOneAndSeveralRanksWithParticleVolumes)
+{
+  expectSameAnswerOnOneAndSeveralRanks("\n  mpm: {solid_volume: particles}");
 }
 
 }  // namespace

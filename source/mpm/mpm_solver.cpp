@@ -688,6 +688,30 @@ struct CellOverlap {
   double lower_share_[Dim];
 };
 
+/// The velocity a particle moves with in G2P, Σ_i w_ip u_i over the node velocities u (its own
+/// material's columns), or a rigid particle's prescribed velocity.
+template <int Dim, class Kernel, class NodeView>
+KOKKOS_INLINE_FUNCTION void particleGridVelocity(const double xp[Dim], const double lp[Dim], int m,
+                                                 const MaterialTable& table, const double origin[Dim],
+                                                 const double spacing[Dim], const BoxLookup& nodes, const NodeView& u,
+                                                 double velocity[Dim])
+{
+  for (int d = 0; d < Dim; ++d) velocity[d] = 0.0;
+  if (table.rigid[m]) {
+    for (int d = 0; d < Dim; ++d) velocity[d] = table.rigid_velocity[m][d];
+    return;
+  }
+  ShapeStencil<Dim, Kernel> s;
+  evaluateShape(xp, origin, spacing, lp, s);
+  for (int k = 0; k < s.size; ++k) {
+    long long node[3] = {0, 0, 0};
+    s.node(k, node);
+    const LocalOrdinal lid = nodes(node[0], node[1], node[2]);
+    if (lid < 0) continue;
+    for (int d = 0; d < Dim; ++d) velocity[d] += s.weight[k] * u(lid, m * Dim + d);
+  }
+}
+
 }  // namespace
 
 template <int Dim>
@@ -746,21 +770,9 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt)
   const auto scatter = KOKKOS_LAMBDA(const int p)
   {
     const int m = material(p);
-    double xp[Dim], lp[Dim], velocity[Dim] = {};
+    double xp[Dim], lp[Dim], velocity[Dim];
     for (int d = 0; d < Dim; ++d) xp[d] = x(p, d), lp[d] = half_width(p, d);
-    if (table.rigid[m]) {
-      for (int d = 0; d < Dim; ++d) velocity[d] = table.rigid_velocity[m][d];
-    } else {
-      ShapeStencil<Dim, Kernel> s;
-      evaluateShape(xp, origin, spacing, lp, s);
-      for (int k = 0; k < s.size; ++k) {
-        long long node[3] = {0, 0, 0};
-        s.node(k, node);
-        const LocalOrdinal lid = nodes(node[0], node[1], node[2]);
-        if (lid < 0) continue;
-        for (int d = 0; d < Dim; ++d) velocity[d] += s.weight[k] * node_vs(lid, m * Dim + d);
-      }
-    }
+    particleGridVelocity<Dim, Kernel>(xp, lp, m, table, origin, spacing, nodes, node_vs, velocity);
     const CellOverlap<Dim> overlap(xp, lp, origin, spacing, count);
     const double mp = mass(p), Vp = volume(p);
     for (int k = 0; k < overlap.count; ++k) {
@@ -956,21 +968,9 @@ void MpmSolver<Dim>::predictCellVolumesWith(const Field<Dim>& change, double dt,
   const auto scatter = KOKKOS_LAMBDA(const int p)
   {
     const int m = material(p);
-    double xp[Dim], lp[Dim], velocity[Dim] = {};
+    double xp[Dim], lp[Dim], velocity[Dim];
     for (int d = 0; d < Dim; ++d) xp[d] = x(p, d), lp[d] = half_width(p, d);
-    if (table.rigid[m]) {
-      for (int d = 0; d < Dim; ++d) velocity[d] = table.rigid_velocity[m][d];
-    } else {
-      ShapeStencil<Dim, Kernel> s;
-      evaluateShape(xp, origin, spacing, lp, s);
-      for (int k = 0; k < s.size; ++k) {
-        long long node[3] = {0, 0, 0};
-        s.node(k, node);
-        const LocalOrdinal lid = nodes(node[0], node[1], node[2]);
-        if (lid < 0) continue;
-        for (int d = 0; d < Dim; ++d) velocity[d] += s.weight[k] * node_u(lid, m * Dim + d);
-      }
-    }
+    particleGridVelocity<Dim, Kernel>(xp, lp, m, table, origin, spacing, nodes, node_u, velocity);
     double moved[Dim];
     for (int d = 0; d < Dim; ++d) moved[d] = xp[d] + dt * velocity[d];
     const CellOverlap<Dim> predicted(moved, lp, origin, spacing, count);

@@ -94,6 +94,13 @@ constexpr const char* kInviscidWater = R"(    water:
       specific_heat: 4157.0
 )";
 
+// Air without viscosity, as a YAML entry of `materials`.
+constexpr const char* kInviscidAir = R"(    air:
+      kind: fluid
+      equation_of_state: {type: ideal_gas, gas_constant: 287.0, gamma: 1.4}
+      viscosity: 0.0
+)";
+
 // Water at rest in a closed 1 m x 0.02 m channel (200 x 4 cells, 5 mm) with a 0.1 m slug moving
 // at 0.1 m/s in the middle: two acoustic pulses run out from it. No gravity, no air.
 Scene acousticScene(const std::string& pressure_scheme)
@@ -400,11 +407,7 @@ TEST(IceScenes, OddEvenFilterGivesTracesBelowZeroNoWeight)
 cfdmpm:
   domain: {dimension: 2, lower: [0.0, 0.0], upper: [0.32, 0.08], cells: [32, 8], patch_cells: [8, 8], gravity: [0.0, 0.0]}
   materials:
-)") + kInviscidWater + R"(    air:
-      kind: fluid
-      equation_of_state: {type: ideal_gas, gas_constant: 287.0, gamma: 1.4}
-      viscosity: 0.0
-  initial_state: {background_material: water, temperature: 293.15, pressure: 101325.0, hydrostatic: false}
+)") + kInviscidWater + kInviscidAir + R"(  initial_state: {background_material: water, temperature: 293.15, pressure: 101325.0, hydrostatic: false}
   time: {end_time: 1.0e-4, dt_initial: 1.0e-4}
   output: {directory: unused, interval: 1.0}
   ice: {odd_even_filter: 0.25}
@@ -451,11 +454,7 @@ Scene hammerScene()
 cfdmpm:
   domain: {dimension: 2, lower: [0.0, 0.0], upper: [0.02, 0.16], cells: [2, 16], patch_cells: [2, 8], gravity: [0.0, 0.0]}
   materials:
-)" + std::string(kInviscidWater) + R"(    air:
-      kind: fluid
-      equation_of_state: {type: ideal_gas, gas_constant: 287.0, gamma: 1.4}
-      viscosity: 0.0
-  initial_state: {background_material: water, temperature: 293.15, pressure: 101325.0, hydrostatic: false}
+)" + std::string(kInviscidWater) + kInviscidAir + R"(  initial_state: {background_material: water, temperature: 293.15, pressure: 101325.0, hydrostatic: false}
   regions:
     all: {material: water, shape: box, lower: [0.0, 0.0], upper: [0.02, 0.16], velocity: [0.0, -2.0]}
   time: {end_time: 1.0}

@@ -1089,7 +1089,6 @@ void IceSolver<Dim>::equilibrationPhase(CellState<Dim>& state, IceStepReport& re
       },
       Kokkos::Max<double>(jump));
   Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_MAX, jump, Teuchos::outArg(report.equilibration_jump));
-
 }
 
 // [4] Face velocities and face exchange.

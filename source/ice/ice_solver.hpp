@@ -24,8 +24,8 @@
 
 #include <Teuchos_Time.hpp>
 
-#include <map>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>

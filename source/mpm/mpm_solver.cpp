@@ -712,6 +712,23 @@ KOKKOS_INLINE_FUNCTION void particleGridVelocity(const double xp[Dim], const dou
   }
 }
 
+/// Adds V_p times the shares of the box of half-width l about x + Δt v (the particle moved by
+/// G2P) to column `column` of the cells it overlaps.
+template <int Dim, class CellView>
+KOKKOS_INLINE_FUNCTION void addMovedBox(const double x[Dim], const double l[Dim], const double velocity[Dim], double dt,
+                                        double Vp, const double origin[Dim], const double spacing[Dim],
+                                        const long long count[Dim], const BoxLookup& cells, const CellView& out,
+                                        int column)
+{
+  double moved[Dim];
+  for (int d = 0; d < Dim; ++d) moved[d] = x[d] + dt * velocity[d];
+  const CellOverlap<Dim> predicted(moved, l, origin, spacing, count);
+  for (int k = 0; k < predicted.count; ++k) {
+    const LocalOrdinal c = cells(predicted.cell[k][0], predicted.cell[k][1], predicted.cell[k][2]);
+    if (c >= 0) out(c, column) += predicted.share[k] * Vp;
+  }
+}
+
 }  // namespace
 
 template <int Dim>
@@ -783,13 +800,7 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt)
       out(c, nm + m) += w * Vp;
       for (int d = 0; d < Dim; ++d) out(c, 2 * nm + m * Dim + d) += w * mp * velocity[d];
     }
-    double moved[Dim];
-    for (int d = 0; d < Dim; ++d) moved[d] = xp[d] + dt * velocity[d];
-    const CellOverlap<Dim> predicted(moved, lp, origin, spacing, count);
-    for (int k = 0; k < predicted.count; ++k) {
-      const LocalOrdinal c = cells(predicted.cell[k][0], predicted.cell[k][1], predicted.cell[k][2]);
-      if (c >= 0) out(c, predictedVolumeColumn(nm, m)) += predicted.share[k] * Vp;
-    }
+    addMovedBox<Dim>(xp, lp, velocity, dt, Vp, origin, spacing, count, cells, out, predictedVolumeColumn(nm, m));
     // Face shares: the particle's volume in the layers of width `layer` cells
     // (MpmOptions::face_layer) just below and just above each interior face its box reaches, per
     // volume of the layer. A moving rigid body's instead (both sides alike): the share of the face
@@ -971,14 +982,7 @@ void MpmSolver<Dim>::predictCellVolumesWith(const Field<Dim>& change, double dt,
     double xp[Dim], lp[Dim], velocity[Dim];
     for (int d = 0; d < Dim; ++d) xp[d] = x(p, d), lp[d] = half_width(p, d);
     particleGridVelocity<Dim, Kernel>(xp, lp, m, table, origin, spacing, nodes, node_u, velocity);
-    double moved[Dim];
-    for (int d = 0; d < Dim; ++d) moved[d] = xp[d] + dt * velocity[d];
-    const CellOverlap<Dim> predicted(moved, lp, origin, spacing, count);
-    const double Vp = volume(p);
-    for (int k = 0; k < predicted.count; ++k) {
-      const LocalOrdinal c = cells(predicted.cell[k][0], predicted.cell[k][1], predicted.cell[k][2]);
-      if (c >= 0) out(c, m) += predicted.share[k] * Vp;
-    }
+    addMovedBox<Dim>(xp, lp, velocity, dt, volume(p), origin, spacing, count, cells, out, m);
   };
   forEachParticleScattering("mpm::predict_cell_volumes", nodes, scatter);
   volumes.sumToOwners();

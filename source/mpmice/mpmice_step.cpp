@@ -247,12 +247,19 @@ void MpmIceStep<Dim>::checkFinite(const CellState<Dim>& state, bool with_pressur
 }
 
 template <int Dim>
+Kokkos::Array<int, ice::kMaxMaterials> MpmIceStep<Dim>::solidSceneIndices() const
+{
+  Kokkos::Array<int, ice::kMaxMaterials> scene_index{};
+  for (std::size_t a = 0; a < mpm_->materials().size(); ++a) scene_index[a] = mpm_->materials()[a].scene_index;
+  return scene_index;
+}
+
+template <int Dim>
 void MpmIceStep<Dim>::cellsFromParticles(CellState<Dim>& state, double dt)
 {
   mpm_->particlesToCells(*cell_sums_, dt);
   const int nm = int(mpm_->materials().size());
-  Kokkos::Array<int, ice::kMaxMaterials> scene_index{};
-  for (int a = 0; a < nm; ++a) scene_index[a] = mpm_->materials()[a].scene_index;
+  const auto scene_index = solidSceneIndices();
   const double volume = layout_->grid().cellVolume();
   const auto sums = cell_sums_->view();
   auto rho = state.density.view();
@@ -299,8 +306,7 @@ void MpmIceStep<Dim>::predictSolidVolumes(const CellState<Dim>& state, double dt
   velocityChange(*trial_state_);
   mpm_->predictCellVolumes(*cell_change_, dt, *predicted_volume_);
   const int nm = int(mpm_->materials().size());
-  Kokkos::Array<int, ice::kMaxMaterials> scene_index{};
-  for (int a = 0; a < nm; ++a) scene_index[a] = mpm_->materials()[a].scene_index;
+  const auto scene_index = solidSceneIndices();
   const double volume = layout_->grid().cellVolume();
   const auto sums = cell_sums_->view();
   const auto predicted = predicted_volume_->view();
@@ -316,8 +322,7 @@ template <int Dim>
 void MpmIceStep<Dim>::velocityChange(const CellState<Dim>& state)
 {
   const int nm = int(mpm_->materials().size());
-  Kokkos::Array<int, ice::kMaxMaterials> scene_index{};
-  for (int a = 0; a < nm; ++a) scene_index[a] = mpm_->materials()[a].scene_index;
+  const auto scene_index = solidSceneIndices();
   const auto u = state.velocity.view();
   const auto solid_u = solid_velocity_->view();
   auto change = cell_change_->view();

@@ -76,12 +76,14 @@ class MpmIceStep {
  private:
   /// The solids' columns of the state (mass density, volume fraction, velocity) from the particles.
   void cellsFromParticles(CellState<Dim>& state, double dt);
+  /// Material a of the particle solver is material scene_index[a] of the state.
+  Kokkos::Array<int, ice::kMaxMaterials> solidSceneIndices() const;
   /// The solids' cell velocity change since cellsFromParticles, in the particle solver's columns.
-  // The solids' volume change over the step as their particles make it with the state's present
-  // pressure (IceSolver::setSolidVolumePredictor): momentum sources and exchange on a copy of the
-  // state, their velocity change to the particles (MpmSolver::predictCellVolumes).
-  void predictSolidVolumes(const CellState<Dim>& state, double dt);
   void velocityChange(const CellState<Dim>& state);
+  /// The solids' volume change over the step as their particles make it with the state's present
+  /// pressure (IceSolver::setSolidVolumePredictor): momentum sources and exchange on a copy of the
+  /// state, their velocity change to the particles (MpmSolver::predictCellVolumes).
+  void predictSolidVolumes(const CellState<Dim>& state, double dt);
   /// [12] Throws StepFailure naming the first cell (lowest global id) or particle (lowest id), its
   /// material and the quantity, if a value of the state or of a particle is not finite
   /// (with_pressure false: the pressure is not looked at).

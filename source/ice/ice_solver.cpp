@@ -178,7 +178,8 @@ IceSolver<Dim>::IceSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>>
       filter_increment_(layout, Location::Cell, settings_.odd_even_filter > 0 ? materials_ * Dim : 1,
                         "odd-even filter increment"),
       old_specific_volume_(layout, Location::Cell, materials_, "old_specific_volume"),
-      solid_reference_pressure_(layout, Location::Cell, 1, "solid_reference_pressure")
+      solid_reference_pressure_(layout, Location::Cell, 1, "solid_reference_pressure"),
+      solid_particle_volume_(layout, Location::Cell, solids.empty() ? 1 : materials_, "solid_particle_volume")
 {
   solid_reference_pressure_.fill(scene.initial.pressure);
   if (!solids.empty()) {
@@ -268,6 +269,7 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
   auto kappa = compressibility_.view();
   auto sum_kappa = mixture_compressibility_.view();
   const auto p_ref = solid_reference_pressure_.view();
+  auto particle_volume = solid_particle_volume_.view();
   const auto ijk = layout_->cellIndex();
   const long long nx = layout_->grid().cells()[0], ny = layout_->grid().cells()[1];
   Kokkos::View<long long, MemorySpace> first("first failed cell");
@@ -295,9 +297,14 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
             for (int m = 0; m < nm; ++m)
               if (!(mass_density[m] > kNegligibleMassShare * cell_mass)) mass_density[m] = 0.0;
             ice::MaterialArray<ice::Eos> local = eos;
-            for (int m = 0; m < nm; ++m)
-              if (roles.lagrangian[m] && mass_density[m] > 0 && theta(c, m) > 0)
-                local[m] = ice::SolidEos(bulk[m], mass_density[m] / theta(c, m), p_ref(c, 0));
+            for (int m = 0; m < nm; ++m) {
+              if (!roles.lagrangian[m]) continue;
+              const bool present = mass_density[m] > 0 && theta(c, m) > 0;
+              if (present) local[m] = ice::SolidEos(bulk[m], mass_density[m] / theta(c, m), p_ref(c, 0));
+              // The particles' own specific volume, before the equilibration compresses the solid's
+              // share (faceVelocities); where the solid is absent or a trace, its material's.
+              particle_volume(c, m) = present ? theta(c, m) / mass_density[m] : 1.0 / eos[m].solid.reference_density;
+            }
             r = ice::equilibrationPressure<N>(nm, local, mass_density, temperature, p(c, 0));
           } else {
             r = ice::equilibrationPressure<N>(nm, eos, mass_density, temperature, p(c, 0));
@@ -328,6 +335,7 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
   for (Field<Dim>* f : {&state.volume_fraction, &state.specific_volume, &state.pressure, &compressibility_,
                         &mixture_compressibility_})
     f->exchangeHalo();
+  if (roles_.any_solid) solid_particle_volume_.exchangeHalo();
   int total = 0;
   Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_SUM, failures, Teuchos::outArg(total));
   first_failed_equilibration_ = -1;
@@ -357,6 +365,7 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
   const auto roles = faceRoles();
   const auto K = pairCoefficients(settings_.exchange_coefficient, n, roles, true);
   const bool with_solids = roles_.any_solid;
+  const auto particle_volume = solid_particle_volume_.view();
   forMaterialCount(n, [&](auto count) {
     constexpr int N = decltype(count)::value;
     for (int d = 0; d < Dim; ++d) {
@@ -381,6 +390,14 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
             ice::MaterialArray<double> tl{}, tr{}, vl{}, vr{}, vel{}, sv{}, own{};
             for (int m = 0; m < nm; ++m) {
               tl[m] = theta(l, m), tr[m] = theta(c, m), vl[m] = v(l, m), vr[m] = v(c, m);
+              // A solid's share of the face is its particles' volume there (solidFaceShares), so
+              // its mass on the face is that share over the particles' specific volume. The
+              // equilibration's may be far smaller: where the fluids overfill a cell the pressure
+              // rises until they fit and a solid's share shrinks as exp(-(p - p_ref)/K) (SolidEos);
+              // a trace of soft sand beside the bed, 2.4 MPa above p_ref with K = 1e5 Pa, then had
+              // a specific volume of 1e-14 m^3/kg and outweighed the water on the face by 1e9, which
+              // pinned the water to the sand's velocity and took its response to the pressure.
+              if (with_solids && roles.lagrangian[m]) vl[m] = particle_volume(l, m), vr[m] = particle_volume(c, m);
               const double rl = rho(l, m), rr = rho(c, m);
               const double ul = u(l, m * Dim + d), ur = u(c, m * Dim + d);
               const double mean = (rl * ul + rr * ur) / (rl + rr + kTiny);

@@ -253,6 +253,7 @@ class IceSolver {
   Field<Dim> filter_laplacian_, filter_increment_;  // filterOddEven's work space (1 column when off)
   Field<Dim> old_specific_volume_;      // v before the Lagrangian update (for the p dv work)
   Field<Dim> solid_reference_pressure_; // p_ref of the solids' equation of state per cell (Pa)
+  Field<Dim> solid_particle_volume_;    // a solid's specific volume as its particles hold it (m^3/kg)
   std::unique_ptr<PressureSolver<Dim>> pressure_solver_;
   std::unique_ptr<Advector<Dim>> advector_;
   std::map<std::string, Teuchos::RCP<Teuchos::Time>> timers_;

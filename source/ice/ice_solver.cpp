@@ -319,12 +319,15 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
           for (int m = 0; m < nm; ++m) {
             theta(c, m) = r.volume_fraction[m];
             // A material without mass keeps its specific volume where the cell's pressure lies
-            // outside what its equation of state can represent (a solid squeezed beyond p_ref + K),
-            // or where its density there is below the smallest double: a soft solid's
-            // exp((p - p_ref)/K) in a cell of water stretched to -72 MPa (K = 1e5 Pa: the softer
-            // sand at 10 mm) gave 5e-312 kg/m^3, an infinite specific volume, and the cell's
-            // momentum exchange refused the step at every Δt.
-            if (mass_density[m] > 0 || (r.density[m] > 1.0 / DBL_MAX && r.density[m] < DBL_MAX)) v(c, m) = 1.0 / r.density[m];
+            // outside what its equation of state can represent (a solid squeezed beyond p_ref + K).
+            // A solid without mass takes its material's: its equation of state, ρ0 exp((p - p_ref)/K),
+            // has no bound below, and a soft solid absent from a pocket of water stretched to -72 MPa
+            // (K = 1e5 Pa: the softer sand at 10 mm) got 1e-306..5e-312 kg/m^3, a specific volume of
+            // 1e305 or infinity, which the cell's momentum exchange turned into NaN at every Δt.
+            if (kSolids && roles.lagrangian[m] && !(mass_density[m] > 0))
+              v(c, m) = 1.0 / eos[m].solid.reference_density;
+            else if (mass_density[m] > 0 || (r.density[m] > 0 && r.density[m] < DBL_MAX))
+              v(c, m) = 1.0 / r.density[m];
             kappa(c, m) = r.compressibility[m] > 0 && r.compressibility[m] < DBL_MAX ? r.compressibility[m] : 0.0;
             sk += r.volume_fraction[m] * kappa(c, m);
           }

@@ -320,12 +320,13 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
             theta(c, m) = r.volume_fraction[m];
             // A material without mass keeps its specific volume where the cell's pressure lies
             // outside what its equation of state can represent (a solid squeezed beyond p_ref + K).
-            // A solid without mass takes its material's: its equation of state, ρ0 exp((p - p_ref)/K),
-            // has no bound below, and a soft solid absent from a pocket of water stretched to -72 MPa
-            // (K = 1e5 Pa: the softer sand at 10 mm) got 1e-306..5e-312 kg/m^3, a specific volume of
-            // 1e305 or infinity, which the cell's momentum exchange turned into NaN at every Δt.
+            // A solid without mass takes its material's (particle_volume above): its equation of
+            // state, ρ0 exp((p - p_ref)/K), has no bound below, and a soft solid absent from a pocket
+            // of water stretched to -72 MPa (K = 1e5 Pa: the softer sand at 10 mm) got
+            // 1e-306..5e-312 kg/m^3, a specific volume of 1e305 or infinity, which the cell's
+            // momentum exchange turned into NaN at every Δt.
             if (kSolids && roles.lagrangian[m] && !(mass_density[m] > 0))
-              v(c, m) = 1.0 / eos[m].solid.reference_density;
+              v(c, m) = particle_volume(c, m);
             else if (mass_density[m] > 0 || (r.density[m] > 0 && r.density[m] < DBL_MAX))
               v(c, m) = 1.0 / r.density[m];
             kappa(c, m) = r.compressibility[m] > 0 && r.compressibility[m] < DBL_MAX ? r.compressibility[m] : 0.0;

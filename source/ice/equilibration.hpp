@@ -152,6 +152,7 @@ EquilibrationResult equilibrationPressure(int count, const MaterialArray<Eos>& e
   else
     p = detail::insideBracket(lo, hi);
   double previous_step = DBL_MAX;  // the first Newton step is always tried
+  double older_step = DBL_MAX;     // the step before the previous one
   bool lo_untried = lower_is_root_bound && p != lo;  // closed bounds not evaluated yet
   bool hi_untried = upper_is_root_bound && p != hi;
   double evaluated_at = 0.0;
@@ -211,11 +212,17 @@ EquilibrationResult equilibrationPressure(int count, const MaterialArray<Eos>& e
     } else if (p_next <= lo && lo_untried && newton_step <= previous_step) {
       p_next = lo;
       lo_untried = false;
-    } else if (!(p_next > lo && p_next < hi) || newton_step > previous_step) {
+    } else if (!(p_next > lo && p_next < hi) || newton_step > previous_step || newton_step > 0.5 * older_step) {
+      // Bisection also where Newton does not halve its step in two iterations (rtsafe's rule,
+      // Numerical Recipes 9.4): the two Newton forms above can take turns across the root, each
+      // step a little shorter than the last, and never converge (a bed cut cell with a trace of
+      // soft sand, K = 1e5 Pa near 1e5 Pa, and water: 100 iterations from 1.0e5 to 1.1e6 Pa and
+      // back, the root at ~3e5 Pa, IceEquilibration.AlternatingNewtonFormsConverge).
       if (!(lo < hi)) break;  // closed on a bound without a root: not converged
       p_next = detail::insideBracket(lo, hi);
       ++result.bisections;
     }
+    older_step = previous_step;
     previous_step = Kokkos::Experimental::fabs(p_next - p);
     p = p_next;
   }

@@ -228,6 +228,43 @@ TEST(Equilibration, SqueezesTheSolidAsFarAsTheFluidsNeed)
   EXPECT_NEAR(r.volume_fraction[0] + r.volume_fraction[1], 1.0, 1e-12);
 }
 
+TEST(Equilibration, AlternatingNewtonFormsConverge)
+{
+  // A cell of the seed scene at 10 mm, 0.51 s (its inputs to the bit): the rigid bed's cut cell
+  // (a quarter, K = 1e10 Pa), a trace of the soft sand (K = 1e5 Pa, at p ~ 1e5 Pa it counts as
+  // gas-like: p / K > 0.5) and water; the shares fill 1.00037 of the cell at the guess. Newton in
+  // 1/p (for the sand) overshoots to 1.3e6 Pa, plain Newton (for the water) comes back to 1.0e5,
+  // each step a little shorter than the last: 100 iterations ended at 1.0015e5 Pa, not converged,
+  // and the run stopped. Bisection where Newton does not halve its step in two iterations finds
+  // the root in a handful.
+  const double p_ref = 0x1.9f288e24d1e2ep+16, guess = 0x1.813bbcc7dbe4fp+16, T = 278.15;
+  MaterialArray<double> mass_density{}, temperature{};
+  mass_density[0] = 0x1.16200000001a1p+11;  // bed, kg/m^3 of the cell
+  mass_density[1] = 0x1.6bd2a9e29e30bp-1;   // sand
+  mass_density[2] = 0x1.76ecb2ea620b8p+9;   // water
+  const double bed_share = 0x1.000000000018p-2, sand_share = 0x1.6c227c7b7bf65p-12;
+  MaterialArray<Eos> eos{};
+  eos[0] = SolidEos(1e10, mass_density[0] / bed_share, p_ref);
+  eos[1] = SolidEos(1e5, mass_density[1] / sand_share, p_ref);
+  const LinearWater water_eos(101325.0, 999.8, 278.15, 0.18, 2.15e9 / 999.8);  // the scene's water
+  eos[2] = water_eos;
+  for (int m = 0; m < 3; ++m) temperature[m] = T;
+  const EquilibrationResult r = equilibrationPressure(3, eos, mass_density, temperature, guess);
+  ASSERT_TRUE(r.converged()) << "status " << int(r.status) << " after " << r.iterations << " at " << r.pressure;
+  // Newton converges quadratically once bracketed: 20 iterations is a generous bound (7 here).
+  EXPECT_LE(r.iterations, 20);
+  // The shares from the EOS written out at the result fill the cell: the bed and sand
+  // exp(-(p - p_ref)/K), the water linear in p (c^2 = 2.15e9/999.8).
+  const double bed = bed_share * std::exp(-(r.pressure - p_ref) / 1e10);
+  const double sand = sand_share * std::exp(-(r.pressure - p_ref) / 1e5);
+  const double water = mass_density[2] / water_eos.density(r.pressure, T);
+  EXPECT_NEAR(bed + sand + water, 1.0, 1e-12);
+  // The root lies where the water has taken the sand's excess: above p_ref by ~0.4 MPa at most
+  // (water alone: 3.7e-4 of the cell at 2.15e9 Pa / 0.75 -> 1.1 MPa; the sand gives most of it).
+  EXPECT_GT(r.pressure, p_ref);
+  EXPECT_LT(r.pressure, p_ref + 1.1e6);
+}
+
 TEST(Equilibration, RunsInsideAParallelKernel)
 {
   // The same solve in a Kokkos kernel over cells whose air fraction sweeps 1e-9 ... 1 - 1e-9.

@@ -35,6 +35,7 @@ import collections
 import csv
 import datetime
 import glob
+import itertools
 import os
 import re
 import sys
@@ -196,7 +197,7 @@ def cmd_chart(a):
     fig, axes = plt.subplots(1, len(times), figsize=(5.5 * len(times) + 0.5, 4.4), sharey=True, squeeze=False)
     axes = axes[0]
     option_sets = sorted({r["options"] for r in rows})
-    markers = dict(zip(option_sets, "osD^v<>"))
+    markers = dict(zip(option_sets, itertools.cycle("osD^v<>phX*P8")))  # any number of option sets
     for ax, t in zip(axes, times):
         for options in option_sets:
             own = sorted((r for r in rows if r["options"] == options), key=lambda r: float(r["wall_s"]))
@@ -220,10 +221,16 @@ def cmd_chart(a):
         ax.set_title("t = %g s" % t)
         ax.grid(True, which="both", alpha=0.3)
     axes[0].set_ylabel("RMS of eta - eta_ref [mm]")
-    axes[0].legend(fontsize=8)
+    # The legend below the panels, in two columns, so that it covers no point however many option
+    # sets the runs CSV holds.
+    handles, labels = axes[0].get_legend_handles_labels()
+    legend_rows = (len(labels) + 1) // 2
+    legend_height = 0.22 * legend_rows + 0.3  # inches
+    fig.set_figheight(fig.get_figheight() + legend_height)
+    fig.legend(handles, labels, loc="lower center", ncol=2, fontsize=8, frameon=False)
     fig.suptitle("Submarine slide (Rzadkiewicz et al. 1997): free-surface error against cost\neta_ref: %s"
                  % os.path.basename(a.reference), fontsize=10)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, legend_height / fig.get_figheight(), 1, 1))
     fig.savefig(a.png, dpi=110)
     print("slide_chart.py: wrote " + a.png)
 

@@ -217,7 +217,7 @@ EquilibrationResult equilibrationPressure(int count, const MaterialArray<Eos>& e
       // Numerical Recipes 9.4): the two Newton forms above can take turns across the root, each
       // step a little shorter than the last, and never converge (a bed cut cell with a trace of
       // soft sand, K = 1e5 Pa near 1e5 Pa, and water: 100 iterations from 1.0e5 to 1.1e6 Pa and
-      // back, the root at ~3e5 Pa, IceEquilibration.AlternatingNewtonFormsConverge).
+      // back, the root at 2.7e5 Pa; Equilibration.AlternatingNewtonFormsConverge).
       if (!(lo < hi)) break;  // closed on a bound without a root: not converged
       p_next = detail::insideBracket(lo, hi);
       ++result.bisections;

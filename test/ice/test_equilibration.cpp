@@ -259,8 +259,8 @@ TEST(Equilibration, AlternatingNewtonFormsConverge)
   const double sand = sand_share * std::exp(-(r.pressure - p_ref) / 1e5);
   const double water = mass_density[2] / water_eos.density(r.pressure, T);
   EXPECT_NEAR(bed + sand + water, 1.0, 1e-12);
-  // The root lies where the water has taken the sand's excess: above p_ref by ~0.4 MPa at most
-  // (water alone: 3.7e-4 of the cell at 2.15e9 Pa / 0.75 -> 1.1 MPa; the sand gives most of it).
+  // The root lies above p_ref, and below the pressure at which the water alone would take the
+  // excess 3.7e-4 of the cell (2.15e9 Pa x 3.7e-4 / 0.75 = 1.1 MPa): the sand gives most of it.
   EXPECT_GT(r.pressure, p_ref);
   EXPECT_LT(r.pressure, p_ref + 1.1e6);
 }

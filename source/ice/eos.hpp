@@ -70,12 +70,21 @@ struct IdealGas {
 /// beta [kg/(m^3 K)] is used with the sign printed in eq. 5 (0.18 in the paper): at fixed pressure
 /// the density then rises with T. Real water near 10 degC has beta ~ -0.15 (Knauss); the seed scene
 /// is isothermal, where beta has no effect.
+///
+/// Cavitation (optional, a cavitation pressure p_c > 0): water does not hold tension; below the
+/// vapour pressure it boils and the cell holds a mixture of liquid and vapour. Below the liquid's
+/// density at p_c, rho_c(T), the law is p = p_c rho / rho_c: the mixture's volume grows as an
+/// isothermal gas's would (p kappa = 1), continuous with the liquid at rho_c. Without it the law
+/// stretches the water linearly to any tension (-80 MPa for a 4 % short cell); with it a cell that
+/// holds too little water sits near p_c and takes the missing volume as vapour, as a real liquid
+/// does (Brennen, "Cavitation and Bubble Dynamics", 1995, ch. 1). p_c = 0: off.
 struct LinearWater {
   double reference_pressure;     // p0 [Pa], 101325 in the paper
   double reference_density;      // rho0 [kg/m^3], 999.8
   double reference_temperature;  // T0 [K], 283.15 (10 degC)
   double beta;                   // [kg/(m^3 K)], 0.18
   double Kf;                     // dp/drho = c^2 [m^2/s^2], 2.15e6
+  double cavitation_pressure = 0.0;  // p_c [Pa]; 0: no cavitation
 
   LinearWater() = default;
   KOKKOS_INLINE_FUNCTION LinearWater(double p0, double rho0, double T0, double beta_, double Kf_)
@@ -89,27 +98,55 @@ struct LinearWater {
     return LinearWater(p0, rho0, T0, beta_, bulk_modulus / rho0);
   }
 
+  /// The same law, cavitating below p_c (> 0, below p0, where the liquid's density is positive).
+  KOKKOS_INLINE_FUNCTION LinearWater withCavitation(double p_c) const
+  {
+    LinearWater w = *this;
+    w.cavitation_pressure = p_c;
+    return w;
+  }
+
   /// rho at p0 and T: the density about which the law is linear.
   KOKKOS_INLINE_FUNCTION double densityAtReferencePressure(double T) const
   {
     return reference_density + beta * (T - reference_temperature);
   }
+  /// rho_c: the liquid's density at the cavitation pressure (0 without cavitation).
+  KOKKOS_INLINE_FUNCTION double cavitationDensity(double T) const
+  {
+    return cavitation_pressure > 0 ? liquidDensity(cavitation_pressure, T) : 0.0;
+  }
   KOKKOS_INLINE_FUNCTION double pressure(double rho, double T) const
   {
+    const double rho_c = cavitationDensity(T);
+    if (rho < rho_c) return cavitation_pressure * (rho / rho_c);
     return reference_pressure + Kf * ((rho - reference_density) - beta * (T - reference_temperature));
   }
-  KOKKOS_INLINE_FUNCTION double dp_drho(double, double) const { return Kf; }
+  KOKKOS_INLINE_FUNCTION double dp_drho(double rho, double T) const
+  {
+    const double rho_c = cavitationDensity(T);
+    return rho < rho_c ? cavitation_pressure / rho_c : Kf;
+  }
   KOKKOS_INLINE_FUNCTION double density(double p, double T) const
   {
-    return densityAtReferencePressure(T) + (p - reference_pressure) / Kf;
+    if (cavitation_pressure > 0 && p < cavitation_pressure) return cavitationDensity(T) * (p / cavitation_pressure);
+    return liquidDensity(p, T);
   }
-  /// c^2 = Kf. The isentropic correction (dp/de)_rho p/rho^2 = -Kf beta p/(cv rho^2) is 4e-6 of Kf
-  /// at 1 atm and is left out, so the EOS needs no cv. (Uintah adds dp_de p/rho^2 with its
-  /// dp_de = -a/k, which is dp/dT, not dp/de; with a = 0.18 that lowers c to 1453 m/s at 1 atm.)
-  KOKKOS_INLINE_FUNCTION double sound_speed_squared(double, double) const { return Kf; }
+  /// c^2 = dp/drho: Kf in the liquid. The isentropic correction (dp/de)_rho p/rho^2 =
+  /// -Kf beta p/(cv rho^2) is 4e-6 of Kf at 1 atm and is left out, so the EOS needs no cv. (Uintah
+  /// adds dp_de p/rho^2 with its dp_de = -a/k, which is dp/dT, not dp/de; with a = 0.18 that lowers
+  /// c to 1453 m/s at 1 atm.)
+  KOKKOS_INLINE_FUNCTION double sound_speed_squared(double rho, double T) const { return dp_drho(rho, T); }
   KOKKOS_INLINE_FUNCTION PressureRange pressure_range(double T) const
   {
+    if (cavitation_pressure > 0) return {0.0, DBL_MAX};
     return {reference_pressure - Kf * densityAtReferencePressure(T), DBL_MAX};
+  }
+
+ private:
+  KOKKOS_INLINE_FUNCTION double liquidDensity(double p, double T) const
+  {
+    return densityAtReferencePressure(T) + (p - reference_pressure) / Kf;
   }
 };
 

@@ -39,6 +39,33 @@ constexpr double kNegligibleVolumeShare = 1e-12;
 // Lagrangian volumes and the pressure equation's residual use it (its matrix: below).
 KOKKOS_INLINE_FUNCTION double volumeLoss(double x) { return x > 0 ? x / (1.0 + x) : x; }
 KOKKOS_INLINE_FUNCTION double volumeLossSlope(double x) { return x > 0 ? 1.0 / ((1.0 + x) * (1.0 + x)) : 1.0; }
+// A cavitating liquid (ice::LinearWater below its cavitation pressure) is compressed by its own law:
+// its vapour behaves as an isothermal gas (the loss above, while the pressure stays below p_c), but
+// once the vapour is gone the liquid is stiff again, so the loss stops near the vapour's share,
+// 1 − ρ/ρ_c. With the gas's law alone the pressure equation let a boiling cell take in water far
+// beyond its vapour, which the next equilibration found as a compression of 1-3 GPa (the seed slide
+// at 5 mm). A pressure fall keeps the linear form.
+KOKKOS_INLINE_FUNCTION bool cavitating(const ice::Eos& eos, double p)
+{
+  return eos.kind == ice::EosKind::LinearWater && p < eos.linear_water.cavitation_pressure;
+}
+/// The share of its volume material m (EOS `eos`, temperature T, compressibility κ at the
+/// equilibration pressure p) loses when the pressure rises by Σδp.
+KOKKOS_INLINE_FUNCTION double materialVolumeLoss(const ice::Eos& eos, double p, double T, double kappa, double sum_dp)
+{
+  if (sum_dp > 0 && cavitating(eos, p)) return 1.0 - eos.density(p, T) / eos.density(p + sum_dp, T);
+  return volumeLoss(kappa * sum_dp);
+}
+/// Its derivative with respect to Σδp (1/Pa).
+KOKKOS_INLINE_FUNCTION double materialVolumeLossSlope(const ice::Eos& eos, double p, double T, double kappa,
+                                                      double sum_dp)
+{
+  if (sum_dp > 0 && cavitating(eos, p)) {
+    const double rho = eos.density(p + sum_dp, T);
+    return eos.density(p, T) / (rho * rho * eos.dp_drho(rho, T));
+  }
+  return kappa * volumeLossSlope(kappa * sum_dp);
+}
 // The pressure matrix's Σθκ is the slope of that loss at Σδp = 0. Where a gas is compressed
 // strongly in one step the slope falls (by 1/(1 + x)²), and an outer iteration with the old one
 // takes steps too short to converge: the matrix follows the slope once it has fallen by more than
@@ -619,6 +646,8 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
   const auto dp = delta_p_.view();
   auto p = state.pressure.view();
   const auto p_eq = equilibrium_pressure_.view();
+  const auto T = state.temperature.view();
+  const auto eos = eos_;
   auto rhs = rhs_.view();
   const double volume = layout_->grid().cellVolume();
   double area[3], dt_per_h[3];
@@ -696,7 +725,8 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
             for (int m = 0; m < nm; ++m)
               if (roles.lagrangian[m]) solid_change += solid_change_view(c, m);
           double compression = 0;  // Σ_m θ_m s(κ_m Σδp): the share of the cell the pressure change takes
-          for (int m = 0; m < nm; ++m) compression += theta(c, m) * volumeLoss(kappa(c, m) * sum_dp(c, 0));
+          for (int m = 0; m < nm; ++m)
+            compression += theta(c, m) * materialVolumeLoss(eos[m], p_eq(c, 0), T(c, m), kappa(c, m), sum_dp(c, 0));
           rhs(c, 0) = volume * solid_change - dt * outflow - volume * compression;
           // A value that is not finite counts as infinite (a NaN would lose every comparison and
           // vanish from the maximum), so that the outer iteration sees it and stops.
@@ -743,6 +773,9 @@ void IceSolver<Dim>::momentumSourcePhase(CellState<Dim>& state, double dt)
   const auto u = state.velocity.view();
   auto v = state.specific_volume.view();
   const auto p_ref = solid_reference_pressure_.view();
+  const auto p_eq = equilibrium_pressure_.view();
+  const auto T = state.temperature.view();
+  const auto eos = eos_;
   const auto mu = viscosity_;
   const auto roles = roles_;
   const bool with_solids = roles_.any_solid;
@@ -859,7 +892,7 @@ void IceSolver<Dim>::momentumSourcePhase(CellState<Dim>& state, double dt)
               const double force = -t[m] * grad_p[k] + mu[m] * t[m] * laplacian + r[m] * g[k];  // per volume
               un(c, m * Dim + k) = uc + dt * force / r[m];  // (not dt / ρ first: ρ can be subnormal)
             }
-            v(c, m) = v(c, m) * (1.0 - volumeLoss(kappa(c, m) * sum_dp(c, 0)));
+            v(c, m) = v(c, m) * (1.0 - materialVolumeLoss(eos[m], p_eq(c, 0), T(c, m), kappa(c, m), sum_dp(c, 0)));
           }
         });
   });
@@ -1254,9 +1287,13 @@ bool IceSolver<Dim>::followCompressibility(const CellState<Dim>& state)
   const auto kappa = compressibility_.view();
   const auto sum_dp = sum_delta_p_.view();
   auto sum_kappa = mixture_compressibility_.view();
+  const auto p_eq = equilibrium_pressure_.view();
+  const auto T = state.temperature.view();
+  const auto eos = eos_;
   const auto slope = KOKKOS_LAMBDA(const LocalOrdinal c) {
     double sk = 0;
-    for (int m = 0; m < n; ++m) sk += theta(c, m) * kappa(c, m) * volumeLossSlope(kappa(c, m) * sum_dp(c, 0));
+    for (int m = 0; m < n; ++m)
+      sk += theta(c, m) * materialVolumeLossSlope(eos[m], p_eq(c, 0), T(c, m), kappa(c, m), sum_dp(c, 0));
     return sk;
   };
   int local = 0;

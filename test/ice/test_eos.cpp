@@ -151,3 +151,33 @@ TEST(Eos, TaggedUnionGivesTheConcreteValues)
   EXPECT_EQ(water.pressure_range(280.0).min, seedWater().pressure_range(280.0).min);
   EXPECT_TRUE(std::isnan(Eos().pressure(1.0, 1.0)));  // kind None
 }
+
+// Cavitation: below p_c the water boils; p = p_c ρ/ρ_c, continuous with the liquid at ρ_c, its
+// density positive at every positive pressure and the round trip exact on both branches.
+TEST(Eos, CavitatingWaterBoilsBelowItsVapourPressure)
+{
+  const double p_c = 872.0;  // Pa, water's vapour pressure at 5 C
+  const LinearWater water = seedWater().withCavitation(p_c);
+  const double rho_c = water.cavitationDensity(kFiveCelsius);
+  // ρ_c is the liquid's density at p_c: the law is continuous there.
+  EXPECT_NEAR(rho_c, seedWater().density(p_c, kFiveCelsius), 1e-12 * rho_c);
+  EXPECT_NEAR(water.pressure(rho_c, kFiveCelsius), p_c, 1e-9 * p_c);  // rounding eps Kf ρ_c, ~1e-7 Pa
+  // A cell 3 % short of water sits 3 % below p_c (the liquid alone would hold -64 MPa).
+  EXPECT_NEAR(water.pressure(0.97 * rho_c, kFiveCelsius), 0.97 * p_c, 1e-12 * p_c);
+  EXPECT_LT(seedWater().pressure(0.97 * rho_c, kFiveCelsius), -6e7);
+  // Above p_c the liquid's law is unchanged, to the bit.
+  EXPECT_EQ(water.pressure(1000.5, kFiveCelsius), seedWater().pressure(1000.5, kFiveCelsius));
+  EXPECT_EQ(water.density(2e5, kFiveCelsius), seedWater().density(2e5, kFiveCelsius));
+  expectRoundTrip(water, {{0.5 * rho_c, kFiveCelsius}, {0.97 * rho_c, kFiveCelsius}, {999.9, kFiveCelsius}});
+  // The boiling branch is an isothermal gas: p κ = 1 (κ = 1 / (ρ c²)).
+  const double rho = 0.9 * rho_c;
+  EXPECT_NEAR(water.pressure(rho, kFiveCelsius) / (rho * water.sound_speed_squared(rho, kFiveCelsius)), 1.0, 1e-12);
+  expectDerivativeMatchesDifference(water, {{0.5 * rho_c, kFiveCelsius}, {1001.0, kFiveCelsius}});
+  // Every positive pressure has a positive density; zero is the range's bound.
+  EXPECT_EQ(water.pressure_range(kFiveCelsius).min, 0.0);
+  EXPECT_GT(water.density(1e-3, kFiveCelsius), 0.0);
+  // Off (p_c = 0, the default): the liquid holds any tension.
+  EXPECT_EQ(seedWater().cavitation_pressure, 0.0);
+  EXPECT_EQ(seedWater().density(-1e6, kFiveCelsius), seedWater().withCavitation(0.0).density(-1e6, kFiveCelsius));
+  EXPECT_LT(seedWater().density(-1e6, kFiveCelsius), 999.8);
+}

@@ -104,6 +104,8 @@ TEST(Equilibration, SingleMaterialReturnsItsEosPressure)
                                    {seedAir(), 1e-3, 278.15},
                                    {seedWater(), 1000.1, kFiveCelsius},
                                    {seedWater(), 990.0, kFiveCelsius},  // tension: p < 0 in eq. 5
+                                   {seedWater().withCavitation(872.0), 990.0, kFiveCelsius},  // boiling: p < p_c
+                                   {seedWater().withCavitation(872.0), 1000.1, kFiveCelsius},
                                    {Tait(999.8, 1466.0, 7.0, kAtmosphere), 1003.0, kFiveCelsius},
                                    {seedSand(), 1990.0, kFiveCelsius}};
   for (const Case& c : cases) {

@@ -1,11 +1,13 @@
 // The ICE solver on whole scenes: still water, an acoustic pulse at large time steps, the same dam
 // break on 1 and 2 ranks.
+#include "ice/eos.hpp"
 #include "ice_scene_support.hpp"
 
 #include <gtest/gtest.h>
 #include <Tpetra_Core.hpp>
 
 #include <cmath>
+#include <string>
 #include <vector>
 
 using namespace cfdmpm;
@@ -444,7 +446,8 @@ struct SoftSandCells {
   static constexpr double kSandDensity = 2000.0, kSandBulk = 1.0e5;
   static constexpr double kWaterDensity = 998.0, kWaterBulk = 2.15e9, kP0 = 101325.0;
 
-  SoftSandCells()
+  /// `water`: the water's entry of `materials` (YAML).
+  explicit SoftSandCells(const std::string& water = kInviscidWater)
       : scene(sceneFromYaml(std::string(R"(
 cfdmpm:
   domain: {dimension: 2, lower: [0.0, 0.0], upper: [0.04, 0.02], cells: [4, 2], patch_cells: [2, 2], gravity: [0.0, 0.0]}
@@ -453,7 +456,7 @@ cfdmpm:
       kind: solid
       density: 2000.0
       model: {type: neo_hookean, bulk_modulus: 1.0e5, shear_modulus: 5.0e4}
-)") + kInviscidWater + R"(  initial_state: {background_material: water, temperature: 293.15, pressure: 101325.0, hydrostatic: false}
+)") + water + R"(  initial_state: {background_material: water, temperature: 293.15, pressure: 101325.0, hydrostatic: false}
   time: {end_time: 1.0e-4, dt_initial: 1.0e-4}
   output: {directory: unused, interval: 1.0}
 )")),
@@ -591,6 +594,112 @@ TEST(IceScenes, AbsentSoftSolidInStretchedWaterKeepsItsSpecificVolume)
     cells.solver.exchangePhase(cells.state, dt, report);
     EXPECT_EQ(report.exchange_failures, 0);
   }
+}
+
+namespace {
+
+constexpr double kVapourPressure = 2339.0;  // Pa, water's at 20 C
+
+// kInviscidWater that boils below kVapourPressure, and its equation of state.
+std::string boilingWaterEntry()
+{
+  std::string entry = kInviscidWater;
+  const std::string last = "reference_temperature: 293.15}";
+  entry.replace(entry.find(last), last.size(), "reference_temperature: 293.15, cavitation_pressure: 2339.0}");
+  return entry;
+}
+ice::LinearWater boilingWater()
+{
+  return ice::LinearWater::fromBulkModulus(SoftSandCells::kWaterBulk, SoftSandCells::kP0, SoftSandCells::kWaterDensity,
+                                           293.15, 0.0)
+      .withCavitation(kVapourPressure);
+}
+
+/// One ICE step of the cells from their columns' state, then the next equilibration; per column of
+/// water cells i in `columns`, the volume the water misses at the solve's pressure,
+/// ρ(p_next) / ρ(p_solved) − 1 (largest magnitude over the column's cells and ranks, signed).
+std::vector<double> volumeMissedInAStep(SoftSandCells& cells, const std::vector<int>& columns, double dt)
+{
+  const double p0 = SoftSandCells::kP0, T = 293.15;
+  const ice::LinearWater water = boilingWater();
+  IceStepReport report;
+  cells.solver.faceVelocityPhase(cells.state, dt);
+  cells.solver.pressurePhase(cells.state, dt, report);
+  EXPECT_TRUE(report.converged);
+  std::vector<double> solved;
+  for (int i : columns) solved.push_back(cells.excessIn(i) + p0);
+  cells.solver.momentumSourcePhase(cells.state, dt);
+  cells.solver.exchangePhase(cells.state, dt, report);
+  cells.solver.advectionPhase(cells.state, dt, report);
+  IceStepReport next;
+  cells.solver.equilibrationPhase(cells.state, next);
+  std::vector<double> missed;
+  for (std::size_t k = 0; k < columns.size(); ++k) {
+    const double found = cells.excessIn(columns[k]) + p0;
+    missed.push_back(water.density(found, T) / water.density(solved[k], T) - 1.0);
+    if (world()->getRank() == 0)
+      std::cout << "cell " << columns[k] << ": solved " << solved[k] << " Pa, next equilibration " << found
+                << " Pa, volume missed " << missed.back() << "\n";
+  }
+  return missed;
+}
+
+}  // namespace
+
+// Water short of its cell boils instead of stretching (`cavitation_pressure`). Cells 0 hold the
+// soft sand (99.5 %) and a trace of water (0.5 %), no particle on their faces; cells 1 hold water
+// that fills 97 % of them, a pocket left behind by sand; cells 2 and 3 are full of water; walls all
+// round. The linear law would stretch the pocket to -64 MPa (the seed slide at 5 mm had such
+// pockets at -80 MPa beside the sand, whose pull on it grew until its particles inverted). Boiling,
+// it sits just below p_c, and the closed box's water follows it down (the pocket's missing volume
+// is vapour). The pressure equation compresses a boiling cell by its own law (the vapour goes, then
+// the stiff liquid), so the next equilibration finds the water of cells 2 and 3 in the volume the
+// solve left it: within the outer tolerance (1e-8 of a cell) and round-off; 1e-7 is allowed. The
+// pocket misses by more: beside a cell that holds a solid the fluids' face fraction fills the room
+// the solid leaves, so the equation counts the face to cells 0 as full of water, and the advection
+// gives only what cells 0 hold (doc/mpmice.md, "Not yet" (9)); the miss is at most that trace
+// (0.5 % of a cell), which boiling turns into a few pascals.
+TEST(IceScenes, PocketOfWaterBoilsAndTheSolveKeepsItsVolume)
+{
+  SoftSandCells cells(boilingWaterEntry());
+  const double pocket = 0.97, trace = 0.005;
+  cells.setColumns([&](int i) { return i == 0 ? 1.0 - trace : 0.0; },
+                   [&](int i) { return (i == 0 ? trace : i == 1 ? pocket : 1.0) * SoftSandCells::kWaterDensity; });
+  IceStepReport report;
+  cells.solver.equilibrationPhase(cells.state, report);
+  const double boiling = cells.excessIn(1) + SoftSandCells::kP0;
+  EXPECT_NEAR(boiling, boilingWater().pressure(pocket * SoftSandCells::kWaterDensity, 293.15), 1e-9 * kVapourPressure);
+  EXPECT_LT(boiling, kVapourPressure);
+  const std::vector<double> missed = volumeMissedInAStep(cells, {1, 2, 3}, 1e-4);
+  EXPECT_LT(std::abs(missed[0]), trace);
+  EXPECT_LT(std::abs(missed[1]), 1e-7);
+  EXPECT_LT(std::abs(missed[2]), 1e-7);
+}
+
+// A boiling pocket (99.5 % of its cells) between water compressed by 20 MPa: the water rushes in,
+// fills the vapour (0.5 % of a cell) and is compressed with the rest, ending near 10 MPa. The
+// pressure equation's law for the boiling cell stops at the vapour's volume, so the next
+// equilibration finds every cell in the volume the solve left it (1e-7, as above; the pocket: below).
+// With an isothermal gas's law throughout the step (x / (1 + x), which lets a compression take all
+// of a cell) the solve left the pocket boiling at 2.4 kPa and the next equilibration found it at
+// 49 MPa, 2.3 % of its volume over.
+TEST(IceScenes, BoilingPocketRefillsToTheVolumeTheSolveLeaves)
+{
+  SoftSandCells cells(boilingWaterEntry());
+  const double pocket = 0.995, squeezed = 1.0 + 2e7 / SoftSandCells::kWaterBulk;
+  cells.setColumns([](int) { return 0.0; },
+                   [&](int i) { return (i == 1 ? pocket : squeezed) * SoftSandCells::kWaterDensity; });
+  IceStepReport report;
+  cells.solver.equilibrationPhase(cells.state, report);
+  EXPECT_LT(cells.excessIn(1) + SoftSandCells::kP0, kVapourPressure);
+  const std::vector<double> missed = volumeMissedInAStep(cells, {0, 1, 2, 3}, 1e-4);
+  // The pocket's water came from cells 20 MPa denser: the equation counts a flux at its donor's
+  // specific volume, and in the pocket that water takes 2e7 / K = 0.93 % more room, so the 0.5 % of
+  // a cell that fills the vapour misses by up to 0.5 % x 0.93 % = 4.7e-5; 5e-5 is allowed.
+  const double donor_volume_error = (1.0 - pocket) * (squeezed - 1.0);
+  for (std::size_t k = 0; k < missed.size(); ++k)
+    EXPECT_LT(std::abs(missed[k]), k == 1 ? 1.07 * donor_volume_error : 1e-7) << "column " << k;
+  EXPECT_GT(cells.excessIn(1) + SoftSandCells::kP0, kVapourPressure);  // refilled: liquid again
 }
 
 TEST(IceScenes, OddEvenFilterIsOffByDefaultAndOnInTheSlide)

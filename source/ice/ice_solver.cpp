@@ -1293,7 +1293,9 @@ bool IceSolver<Dim>::followCompressibility(const CellState<Dim>& state)
   const auto slope = KOKKOS_LAMBDA(const LocalOrdinal c) {
     double sk = 0;
     for (int m = 0; m < n; ++m)
-      sk += theta(c, m) * materialVolumeLossSlope(eos[m], p_eq(c, 0), T(c, m), kappa(c, m), sum_dp(c, 0));
+      sk += sum_dp(c, 0) > 0 && cavitating(eos[m], p_eq(c, 0))
+                ? theta(c, m) * materialVolumeLossSlope(eos[m], p_eq(c, 0), T(c, m), kappa(c, m), sum_dp(c, 0))
+                : theta(c, m) * kappa(c, m) * volumeLossSlope(kappa(c, m) * sum_dp(c, 0));
     return sk;
   };
   int local = 0;

@@ -56,15 +56,15 @@ KOKKOS_INLINE_FUNCTION double materialVolumeLoss(const ice::Eos& eos, double p, 
   if (sum_dp > 0 && cavitating(eos, p)) return 1.0 - eos.density(p, T) / eos.density(p + sum_dp, T);
   return volumeLoss(kappa * sum_dp);
 }
-/// Its derivative with respect to Σδp (1/Pa).
-KOKKOS_INLINE_FUNCTION double materialVolumeLossSlope(const ice::Eos& eos, double p, double T, double kappa,
-                                                      double sum_dp)
+/// θ times its derivative with respect to Σδp (1/Pa): the material's term of the matrix's Σθκ.
+KOKKOS_INLINE_FUNCTION double materialVolumeLossSlope(const ice::Eos& eos, double p, double T, double theta,
+                                                      double kappa, double sum_dp)
 {
   if (sum_dp > 0 && cavitating(eos, p)) {
     const double rho = eos.density(p + sum_dp, T);
-    return eos.density(p, T) / (rho * rho * eos.dp_drho(rho, T));
+    return theta * (eos.density(p, T) / (rho * rho * eos.dp_drho(rho, T)));
   }
-  return kappa * volumeLossSlope(kappa * sum_dp);
+  return theta * kappa * volumeLossSlope(kappa * sum_dp);
 }
 // The pressure matrix's Σθκ is the slope of that loss at Σδp = 0. Where a gas is compressed
 // strongly in one step the slope falls (by 1/(1 + x)²), and an outer iteration with the old one
@@ -1293,9 +1293,7 @@ bool IceSolver<Dim>::followCompressibility(const CellState<Dim>& state)
   const auto slope = KOKKOS_LAMBDA(const LocalOrdinal c) {
     double sk = 0;
     for (int m = 0; m < n; ++m)
-      sk += sum_dp(c, 0) > 0 && cavitating(eos[m], p_eq(c, 0))
-                ? theta(c, m) * materialVolumeLossSlope(eos[m], p_eq(c, 0), T(c, m), kappa(c, m), sum_dp(c, 0))
-                : theta(c, m) * kappa(c, m) * volumeLossSlope(kappa(c, m) * sum_dp(c, 0));
+      sk += materialVolumeLossSlope(eos[m], p_eq(c, 0), T(c, m), theta(c, m), kappa(c, m), sum_dp(c, 0));
     return sk;
   };
   int local = 0;

@@ -1,6 +1,6 @@
 #include "ice/material_eos.hpp"
 
-#include <sstream>
+#include "input/parameter_rule.hpp"
 
 namespace cfdmpm {
 
@@ -19,16 +19,11 @@ ice::Eos fluidEos(const MaterialSpec& material)
     const double p_c = eos.get<double>("cavitation_pressure");
     if (p_c == 0.0) return ice::Eos(water);
     const std::string key = "cfdmpm.materials." + material.name + ".equation_of_state.cavitation_pressure";
-    const auto text = [](double x) {
-      std::ostringstream s;
-      s << x;
-      return s.str();
-    };
     if (!(p_c < water.reference_pressure))
-      throw InputError(key + ": got " + text(p_c) + " Pa; must be below reference_pressure (" +
-                       text(water.reference_pressure) + " Pa), or 0 for no cavitation");
+      throw InputError(key + ": got " + showNumber(p_c) + " Pa; must be below reference_pressure (" +
+                       showNumber(water.reference_pressure) + " Pa), or 0 for no cavitation");
     if (!(water.density(p_c, water.reference_temperature) > 0))
-      throw InputError(key + ": got " + text(p_c) +
+      throw InputError(key + ": got " + showNumber(p_c) +
                        " Pa, where the linear law gives the liquid no positive density; must be higher, or 0");
     return ice::Eos(water.withCavitation(p_c));
   }

@@ -617,7 +617,7 @@ ice::LinearWater boilingWater()
 
 /// One ICE step of the cells from their columns' state, then the next equilibration; per column of
 /// water cells i in `columns`, the volume the water misses at the solve's pressure,
-/// ρ(p_next) / ρ(p_solved) − 1 (largest magnitude over the column's cells and ranks, signed).
+/// ρ(p_next) / ρ(p_solved) − 1, each pressure the column's largest over its cells and ranks.
 std::vector<double> volumeMissedInAStep(SoftSandCells& cells, const std::vector<int>& columns, double dt)
 {
   const double p0 = SoftSandCells::kP0, T = 293.15;

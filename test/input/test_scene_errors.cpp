@@ -359,7 +359,7 @@ TEST_F(SceneTest, CavitationPressureIsChecked)
 {
   const std::string water = "thermal_expansion: 0.18}";
   expectMentions(errorOf(replaced(kFullScene, water, "thermal_expansion: 0.18, cavitation_pressure: 2.0e5}")),
-                 {"cfdmpm.materials.water.equation_of_state.cavitation_pressure", "got 200000 Pa",
+                 {"cfdmpm.materials.water.equation_of_state.cavitation_pressure", "got 2e+05 Pa",
                   "below reference_pressure (101000 Pa)", "or 0 for no cavitation"});
   expectMentions(errorOf(replaced(kFullScene, water, "thermal_expansion: 0.18, cavitation_pressure: -5.0}")),
                  {"cfdmpm.materials.water.equation_of_state.cavitation_pressure", "-5", ">= 0"});

@@ -199,10 +199,15 @@ struct PressureSolver<Dim>::Impl {
   bool values_changed = false;  // since the preconditioner last saw the matrix
   bool rebuild_requested = false;
   int solves_since_setup = 0;
-  // Per kind of solve (solve()'s kind): CG iterations per decade of residual reduction of the last
-  // solve of that kind with a fresh hierarchy (0: none yet); a reused hierarchy that needs `reuse
-  // slowdown limit` times more than that for a solve of the same kind is replaced.
+  // Per kind of solve (solve()'s kind): CG iterations per decade of residual reduction of the first
+  // solve of that kind with the current hierarchy (0: none yet); a later solve of the same kind that
+  // needs `reuse slowdown limit` times more is followed by a full setup. After a setup every kind's
+  // reference is due again, whichever kind's solve the setup happened in: a setup requested by one
+  // kind happens in the next solve, of another kind, and a reference renewed only for that kind left
+  // the first kind comparing the new hierarchy with the old one's measure (the seed slide at 5 mm
+  // then set up its hierarchy at nearly every step).
   std::array<double, PressureSolver<Dim>::kSolveKinds> fresh_iterations_per_decade{};
+  std::array<bool, PressureSolver<Dim>::kSolveKinds> reference_due{};
 
   void buildGraph();
   Teuchos::ParameterList mueluParameters() const;
@@ -332,6 +337,7 @@ Teuchos::RCP<Operator> PressureSolver<Dim>::Impl::preparePreconditioner(Pressure
     muelu = MueLu::CreateTpetraPreconditioner(Teuchos::RCP<Operator>(matrix), parameters);
     solves_since_setup = 0;
     rebuild_requested = false;
+    reference_due.fill(true);
     report.preconditioner_rebuilt = true;
   } else if (values_changed && settings.reuse_mode != ReuseMode::Frozen) {
     // Keep the coarse levels and recompute the finest level's smoother only (RAP), keep the
@@ -630,16 +636,25 @@ PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>
   ++m.solves_since_setup;
 
   // 4. Has the reused hierarchy grown stale? Compare the iterations per decade of reduction of
-  //    ||rhs − A x|| / ||rhs|| with those of the last fresh hierarchy (the caller's guess counts as
-  //    no better than zero, so a good guess can only make a reused hierarchy look better).
+  //    ||rhs − A x|| / ||rhs|| with those of this kind's first solve with the hierarchy (the
+  //    caller's guess counts as no better than zero, so a good guess can only make a reused
+  //    hierarchy look better).
   if (s.preconditioner == PreconditionerType::MueLu && report.converged && report.iterations > 0 &&
       report.relative_residual > 0 && report.relative_residual < 0.1) {
     const double per_decade = report.iterations / -std::log10(report.relative_residual);
-    // (After a failed reuse the count includes the failed attempt: no reference until the next setup.)
-    double& fresh = m.fresh_iterations_per_decade[std::clamp(kind, 0, kSolveKinds - 1)];
-    if (report.preconditioner_rebuilt) fresh = reused ? 0.0 : per_decade;
-    else if (s.reuse_slowdown_limit > 0 && fresh > 0 && per_decade > s.reuse_slowdown_limit * fresh)
+    const int k = std::clamp(kind, 0, kSolveKinds - 1);
+    double& fresh = m.fresh_iterations_per_decade[k];
+    // After a failed reuse the count includes the failed attempt: the next solve of this kind,
+    // with the hierarchy built here, gives the reference.
+    const bool counts_failed_attempt = report.preconditioner_rebuilt && reused;
+    if (m.reference_due[k]) {
+      if (!counts_failed_attempt) {
+        fresh = per_decade;
+        m.reference_due[k] = false;
+      }
+    } else if (s.reuse_slowdown_limit > 0 && fresh > 0 && per_decade > s.reuse_slowdown_limit * fresh) {
       m.rebuild_requested = true;
+    }
   }
 
   if (s.verbosity >= 1 && m.layout->comm()->getRank() == 0) {

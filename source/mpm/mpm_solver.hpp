@@ -70,6 +70,10 @@ struct MpmOptions {
   /// before the coupled step's velocity change (addCellVelocityChange), which reaches only their
   /// velocities; their motion is then the one the fluids' pressure equation was given.
   bool move_before_coupling = false;
+  /// A rigid material at rest (a bed) adds the same to the nodes and the cells at every step: its
+  /// particles are summed once and their sums copied in (false: summed at every step like the rest,
+  /// for comparison).
+  bool stationary_sums_once = true;
 };
 
 /// The options the scene's `mpm` section asks for (its values were checked when it was read).
@@ -210,6 +214,14 @@ class MpmSolver {
   const Field<Dim>& nodeVelocityStar() const { return *node_velocity_star_; }
 
  private:
+  // The sums of the particles of rigid materials at rest (before the sum across ranks): into the
+  // nodes (particlesToGrid) and into the cells (particlesToCells). Empty until first needed, and
+  // again after anything that may change them (a new division, restored particles, gravity).
+  struct StationarySums {
+    typename Field<Dim>::View values;
+    bool valid = false;
+  };
+
   /// f(UniformGimp()) or f(LinearHat()), as the options choose: each phase's kernel is a template
   /// on the shape function.
   template <class F>
@@ -237,6 +249,11 @@ class MpmSolver {
   /// the same node.
   template <class F>
   void forEachParticleScattering(const char* label, const BoxLookup& lookup, const F& f);
+  /// The scatter `f` of every particle into `sums` (zeroed first), the particles of rigid
+  /// materials at rest summed once into `stationary` and copied in (MpmOptions::stationary_sums_once).
+  template <class F>
+  void scatterWithStationarySums(const char* label, const BoxLookup& lookup, Field<Dim>& sums,
+                                 StationarySums& stationary, const F& f);
   void allocateNodeFields();
 
   std::shared_ptr<const Layout<Dim>> layout_;
@@ -260,6 +277,7 @@ class MpmSolver {
   std::unique_ptr<Field<Dim>> node_velocity_predicted_;  // predictCellVolumes: v* + a trial change
   // With more than one thread, the particle-to-node scatters run tile colour by tile colour
   // (ParticleBins); the bins of P2G hold until G2P moves the particles.
+  StationarySums stationary_nodes_, stationary_cells_;
   ParticleBins<Dim> bins_;
   bool bins_current_ = false;
 };

@@ -129,3 +129,58 @@ TEST(MaterialContact, BlockSlidesOnTiltedRigidPlateWithContactFriction)
   // is not exactly the plate's normal at the block's corners.
   EXPECT_LT(worst, 0.03);
 }
+
+// A rigid body at rest (the plate) adds the same to the nodes and the cells at every step, so its
+// particles are summed once (MpmOptions::stationary_sums_once). Those sums are the full sum's to
+// round-off (the order of the additions differs): at the start, after the block has fallen for a
+// while, and after gravity changed (the plate's weight is in the node forces). Bound: 1e-12 of a
+// column's largest entry, far above the round-off of reordering ~16 additions (~1e-15) and far
+// below what one particle adds (~1e-2 of a node's sum).
+TEST(MaterialContact, PlateAtRestSummedOnceAddsWhatAFullSumAdds)
+{
+  const Scene scene = plateScene({0, -9.81, 0}, 2 * kH);
+  MpmOptions once, every;
+  once.cfl = every.cfl = 0.4;
+  every.stationary_sums_once = false;
+  const auto layout = scenes::layoutFor<2>(scene, Tpetra::getDefaultComm());
+  MpmSolver<2> a(scene, layout, once), b(scene, layout, every);
+  const int columns = MpmSolver<2>::cellColumns(2);
+  Field<2> cells_a(layout, Location::Cell, columns, "cells, plate summed once");
+  Field<2> cells_b(layout, Location::Cell, columns, "cells, plate summed every time");
+  const double dt = a.stableTimeStep().dt;
+  const auto largestDifference = [](const Field<2>& x, const Field<2>& y) {
+    const auto u = x.view(), w = y.view();
+    double worst = 0;
+    for (std::size_t j = 0; j < u.extent(1); ++j) {
+      double scale = 0, difference = 0;
+      for (std::size_t i = 0; i < u.extent(0); ++i) {
+        scale = std::max(scale, std::abs(w(i, j)));
+        difference = std::max(difference, std::abs(u(i, j) - w(i, j)));
+      }
+      if (scale > 0) worst = std::max(worst, difference / scale);
+      else worst = std::max(worst, difference);
+    }
+    return worst;
+  };
+  const auto compare = [&](const char* when) {
+    a.particlesToGrid();
+    b.particlesToGrid();
+    a.particlesToCells(cells_a, dt);
+    b.particlesToCells(cells_b, dt);
+    const double nodes = largestDifference(a.nodeSums(), b.nodeSums());
+    const double cells = largestDifference(cells_a, cells_b);
+    std::printf("[ contact  ] plate summed once, %s: node sums differ by %.1e, cell sums by %.1e of a column\n", when,
+                nodes, cells);
+    EXPECT_LE(nodes, 1e-12) << when;
+    EXPECT_LE(cells, 1e-12) << when;
+  };
+  compare("at the start");
+  for (int step = 0; step < 30; ++step) {
+    a.step(dt);
+    b.step(dt);
+  }
+  compare("after 30 steps");
+  a.setGravity({0, -1.0, 0});
+  b.setGravity({0, -1.0, 0});
+  compare("with another gravity");
+}

@@ -170,7 +170,7 @@ def log_numbers(case):
                 completed="\nEnd\n" in text)
 
 
-def cmd_extract(case, h, out, note):
+def cmd_extract(case, h, out, note, cores=1):
     nx, ny = counts(h)
     _, i, j = cell_index(case, h)
     times = sorted((float(d), d) for d in os.listdir(case)
@@ -192,11 +192,12 @@ def cmd_extract(case, h, out, note):
     mm = "%g" % (h * 1000)
     cells = len(i)
     os.makedirs(out, exist_ok=True)
-    path = os.path.join(out, "openfoam-rzadkiewicz-%smm.csv" % mm)
+    path = os.path.join(out, result_name(mm, cores))
     date = datetime.datetime.utcnow().strftime("%Y-%m-%d")
     with open(path, "w", newline="") as f:
         f.write(PROVENANCE.format(
             h=h * 1000, nx=nx, ny=ny, cells=cells, removed=nx * ny - cells, date=date,
+            run=RUN_SERIAL if cores == 1 else RUN_PARALLEL.format(cores=cores),
             wall=info.get("wall", np.nan), cpu=info.get("cpu", np.nan), steps=info.get("steps", -1),
             dt_min=info.get("dt_min", np.nan), dt_max=info.get("dt_max", np.nan), end=info.get("end", np.nan),
             completed="ran to the end" if info.get("completed") else "DID NOT FINISH (last time above)",
@@ -208,17 +209,14 @@ def cmd_extract(case, h, out, note):
     print("wrote %s (%d times)" % (path, len(times)))
     # The summary over all resolutions: this resolution's rows replaced.
     spath = os.path.join(out, "openfoam-rzadkiewicz-summary.csv")
-    fields = ["cell_size_mm", "time", "trough_m", "trough_x", "crest_m", "crest_x", "front_x", "wall_s",
+    fields = ["cell_size_mm", "cores", "time", "trough_m", "trough_x", "crest_m", "crest_x", "front_x", "wall_s",
               "cpu_s", "steps"]
-    old = []
-    if os.path.exists(spath):
-        old = [r for r in csv.DictReader(l for l in open(spath) if not l.startswith("#"))
-               if r["cell_size_mm"] != mm]
-    new = [dict(cell_size_mm=mm, time="%g" % r["time"], trough_m="%.5f" % r["trough"],
+    old = [r for r in read_summary(spath) if (r["cell_size_mm"], r["cores"]) != (mm, str(cores))]
+    new = [dict(cell_size_mm=mm, cores=str(cores), time="%g" % r["time"], trough_m="%.5f" % r["trough"],
                 trough_x="%.4f" % r["trough_x"], crest_m="%.5f" % r["crest"], crest_x="%.4f" % r["crest_x"],
                 front_x="%.4f" % r["front"], wall_s="%.0f" % info.get("wall", np.nan),
                 cpu_s="%.0f" % info.get("cpu", np.nan), steps=str(info.get("steps", -1))) for r in summary]
-    allrows = sorted(old + new, key=lambda r: (-float(r["cell_size_mm"]), float(r["time"])))
+    allrows = sorted(old + new, key=lambda r: (int(r["cores"]), -float(r["cell_size_mm"]), float(r["time"])))
     with open(spath, "w", newline="") as f:
         f.write(SUMMARY_HEADER)
         w = csv.DictWriter(f, fieldnames=fields, lineterminator="\n")
@@ -237,7 +235,8 @@ PROVENANCE = """\
 # linear between cell centres) - 1.6 m, at each column centre x, at every written time (seconds).
 # Made by utilities/openfoam_slide.sh (case template data/reference/openfoam-rzadkiewicz/,
 # extraction utilities/openfoam_slide.py; doc/openfoam-slide.md), on {date} (UTC), on the project's
-# 2-core development machine (Debian bookworm), one core (serial run, nice), the other core busy.
+# 2-core development machine (Debian bookworm),
+# {run}.
 #   OpenFOAM v1912 (Debian package openfoam 1912.200626-1+b1), multiphaseInterFoam, incompressible,
 #   laminar, 2-D (one cell thick, empty front/back), no surface tension.
 #   Mesh: uniform square cells h = {h:g} mm, blockMesh {nx} x {ny} of the tank x in [-2.02, 1.5],
@@ -266,8 +265,26 @@ SUMMARY_HEADER = """\
 # doc/openfoam-slide.md). Per resolution and written time: trough (smallest eta, m) and its x,
 # crest (largest eta) and its x, slide front (largest x at which alpha.sand = 1/2 along a row of
 # cells, linear between cell centres), wall (ClockTime) and CPU (ExecutionTime) seconds of the
-# whole run and its number of time steps. One core of the project's 2-core Debian bookworm machine.
+# whole run and its number of time steps, on `cores` cores of the project's 2-core Debian bookworm
+# machine (1: a serial run; more: mpirun -np cores, the mesh divided into strips in x of equal cell counts).
 """
+RUN_SERIAL = "one core (serial run, nice)"
+RUN_PARALLEL = "{cores} cores (mpirun -np {cores} multiphaseInterFoam -parallel; the mesh in strips in x of equal cell counts; nice)"
+
+
+def result_name(mm, cores):
+    """The eta CSV of one run: openfoam-rzadkiewicz-<h>mm.csv (serial) or -<h>mm-<cores>cores.csv."""
+    return "openfoam-rzadkiewicz-%smm%s.csv" % (mm, "" if int(cores) == 1 else "-%dcores" % int(cores))
+
+
+def read_summary(path):
+    """The summary's rows; a row written before the cores column (serial runs only) gets cores 1."""
+    if not os.path.exists(path):
+        return []
+    rows = list(csv.DictReader(l for l in open(path) if not l.startswith("#")))
+    for r in rows:
+        r["cores"] = r.get("cores") or "1"
+    return rows
 
 
 def read_eta_csv(path):
@@ -311,6 +328,7 @@ def main():
     p.add_argument("--out", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data",
                                                  "reference"))
     p.add_argument("--note", default="", help="a line for the CSV header (e.g. why a run stopped)")
+    p.add_argument("--cores", type=int, default=1, help="extract: the cores the run used (mpirun -np)")
     a = p.parse_args()
     if a.step == "compare":
         cmd_compare(a.case, a.h)
@@ -321,7 +339,7 @@ def main():
     elif a.step == "init":
         cmd_init(a.case, a.h)
     else:
-        cmd_extract(a.case, a.h, os.path.normpath(a.out), a.note)
+        cmd_extract(a.case, a.h, os.path.normpath(a.out), a.note, a.cores)
 
 
 if __name__ == "__main__":

@@ -12,7 +12,8 @@ the chart and the pictures of doc/validation.md.
                       time step's most frequent limiter.
   chart               the log-log PNG of eta RMS error against wall time, one point per row of the runs
                       CSV, with OpenFOAM's runs (data/reference/openfoam-rzadkiewicz-*.csv, wall time
-                      from its summary) measured against the same reference on the same axes.
+                      from its summary; one line per number of cores) measured against the same
+                      reference on the same axes.
   table               the runs CSV as a Markdown table (heights in mm, positions in m), for doc/validation.md.
   profiles [LABEL=DIR ...]  eta(x) side by side: the reference, cfdmpm runs, OpenFOAM's 10 and 5 mm runs.
   picture H5          the slide and the wave of one output: the water volume fraction and the
@@ -164,14 +165,14 @@ def cmd_point(directory, log, a):
 
 
 def openfoam_points(reference):
-    """Per OpenFOAM resolution: (cell size mm, wall s, eta RMS at each of TIMES) against the reference."""
+    """Per OpenFOAM run: (cores, cell size mm, wall s, eta RMS at each of TIMES) against the reference."""
     walls = {}
     path = os.path.join(ROOT, "data", "reference", "openfoam-rzadkiewicz-summary.csv")
-    for r in csv.DictReader(l for l in open(path) if not l.startswith("#")):
-        walls[float(r["cell_size_mm"])] = float(r["wall_s"])
+    for r in openfoam_slide.read_summary(path):
+        walls[(int(r["cores"]), float(r["cell_size_mm"]))] = float(r["wall_s"])
     points = []
-    for h, wall in sorted(walls.items()):
-        data = openfoam_slide.read_eta_csv(os.path.join(ROOT, "data", "reference", "openfoam-rzadkiewicz-%gmm.csv" % h))
+    for (cores, h), wall in sorted(walls.items()):
+        data = openfoam_slide.read_eta_csv(os.path.join(ROOT, "data", "reference", openfoam_slide.result_name("%g" % h, cores)))
         errors = []
         for t in TIMES:
             if t not in reference:
@@ -180,7 +181,7 @@ def openfoam_points(reference):
             x, eta = np.array(data[t]).T
             ref_x, ref_eta = reference[t]
             errors.append(slide_profile.eta_rms(x, eta, ref_x, ref_eta))
-        points.append((h, wall, errors))
+        points.append((cores, h, wall, errors))
     return points
 
 
@@ -210,11 +211,14 @@ def cmd_chart(a):
             ax.plot(wall, error, marker=markers[options], label="cfdmpm, " + options)
             for r, w, e in zip(own, wall, error):
                 ax.annotate("%s mm" % r["cell_size_mm"], (w, e), textcoords="offset points", xytext=(4, 4), fontsize=8)
-        wall = [p[1] for p in foam]
-        error = [1000 * p[2][TIMES.index(t)] for p in foam]
-        ax.plot(wall, error, "k--", marker="x", label="OpenFOAM multiphaseInterFoam, Bingham sand (1 core)")
-        for p, w, e in zip(foam, wall, error):
-            ax.annotate("%g mm" % p[0], (w, e), textcoords="offset points", xytext=(4, -10), fontsize=8)
+        for cores, style in zip(sorted({p[0] for p in foam}), itertools.cycle(["k--", "k:"])):
+            runs = [p for p in foam if p[0] == cores]
+            wall = [p[2] for p in runs]
+            error = [1000 * p[3][TIMES.index(t)] for p in runs]
+            ax.plot(wall, error, style, marker="x" if cores == 1 else "+",
+                    label="OpenFOAM multiphaseInterFoam, Bingham sand (%d core%s)" % (cores, "" if cores == 1 else "s"))
+            for p, w, e in zip(runs, wall, error):
+                ax.annotate("%g mm" % p[1], (w, e), textcoords="offset points", xytext=(4, -10), fontsize=8)
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel("wall time [s]")

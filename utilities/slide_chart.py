@@ -157,7 +157,7 @@ def cmd_point(directory, log, a):
         handle.write("# cfdmpm's runs of the submarine slide (input/rzadkiewicz.yaml) against the 5 mm reference\n"
                      "# (data/reference/cfdmpm-rzadkiewicz-5mm.csv): one row per run, written by\n"
                      "# utilities/slide_chart.py point (definitions there). Lengths in m, times in s.\n")
-        writer = csv.DictWriter(handle, RUN_COLUMNS)
+        writer = csv.DictWriter(handle, RUN_COLUMNS, lineterminator="\n")
         writer.writeheader()
         writer.writerows(rows)
     print("slide_chart.py: %s: eta RMS %s m (0.4 s), %s m (0.8 s), %s s wall on %d rank(s)" % (

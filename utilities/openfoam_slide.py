@@ -207,7 +207,7 @@ def cmd_extract(case, h, out, note, cores=1):
         for t, xx, ee in rows:
             w.writerow(["%g" % t, "%.6f" % xx, "nan" if not np.isfinite(ee) else "%.6f" % ee])
     print("wrote %s (%d times)" % (path, len(times)))
-    # The summary over all resolutions: this resolution's rows replaced.
+    # The summary over all resolutions and core counts: this run's (resolution, cores) rows replaced.
     spath = os.path.join(out, "openfoam-rzadkiewicz-summary.csv")
     fields = ["cell_size_mm", "cores", "time", "trough_m", "trough_x", "crest_m", "crest_x", "front_x", "wall_s",
               "cpu_s", "steps"]

@@ -279,7 +279,7 @@ def cmd_profiles(a):
         runs = {round(r["time"], 6): (r["x"], r["eta"]) for r in slide_profile.profile(directory, profile_args())}
         curves.append(("cfdmpm, " + label, runs, "-"))
     for h in (10, 5):
-        data = openfoam_slide.read_eta_csv(os.path.join(ROOT, "data", "reference", "openfoam-rzadkiewicz-%dmm.csv" % h))
+        data = openfoam_slide.read_eta_csv(os.path.join(ROOT, "data", "reference", openfoam_slide.result_name("%g" % h, 1)))
         curves.append(("OpenFOAM, %d mm" % h, {t: tuple(np.array(rows).T) for t, rows in data.items()}, "--"))
     fig, axes = plt.subplots(len(times), 1, figsize=(10, 3.6 * len(times)), squeeze=False)
     for ax, t in zip(axes[:, 0], times):

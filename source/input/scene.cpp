@@ -1016,6 +1016,7 @@ MpmSpec readMpm(ParameterList& list)
   mpm.face_layer = list.get<double>("face_layer");
   mpm.coupling = list.get<std::string>("coupling");
   mpm.solid_volume = list.get<std::string>("solid_volume");
+  mpm.substeps = list.get<int>("substeps");
   return mpm;
 }
 

@@ -90,6 +90,7 @@ struct MpmSpec {
   double face_layer = 0.125;            // cells: layer in which a solid's cover of a face is measured
   std::string coupling = "monolithic";  // monolithic | staggered (fluid-solid pressure coupling)
   std::string solid_volume = "faces";   // faces | particles (the solids' volume change in the pressure equation)
+  int substeps = 1;                     // most particle steps in one step of the fluids
 };
 
 struct Scene {

@@ -486,6 +486,16 @@ void checkSolverSettings(const Scene& scene)
                      "allowed with mpm.coupling: monolithic only (the staggered coupling fixes the solids' motion "
                      "before the pressure); set solid_volume: faces or coupling: monolithic");
   }
+  if (scene.mpm.substeps > 1 && scene.mpm.solid_volume != "faces") {
+    throw inputError("cfdmpm.mpm.substeps", std::to_string(scene.mpm.substeps),
+                     "allowed: 1 with mpm.solid_volume: particles (its trial moves are one grid update long); set "
+                     "substeps: 1 or solid_volume: faces");
+  }
+  if (scene.mpm.substeps > 1 && scene.mpm.coupling != "monolithic") {
+    throw inputError("cfdmpm.mpm.substeps", std::to_string(scene.mpm.substeps),
+                     "allowed: 1 with mpm.coupling: staggered (the staggered coupling moves the particles before "
+                     "the pressure, in one step); set substeps: 1 or coupling: monolithic");
+  }
   if (scene.mpm.solid_volume == "particles" && ice_runs && ice.get<std::string>("pressure") != "implicit") {
     throw inputError("cfdmpm.mpm.solid_volume", "particles",
                      "allowed with ice.pressure: implicit only (it acts in the implicit pressure's outer iterations)");

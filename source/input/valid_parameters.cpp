@@ -234,6 +234,15 @@ void defineMpm(ParameterList& mpm)
          "the seed scene, at 2x the step's cost at 20 mm and ~5x at 10 mm; doc/mpmice.md, \"The solids' volume "
          "from their particles\").",
          oneOf({"faces", "particles"}));
+  define(mpm, "substeps", 1,
+         "Most particle steps in one step of the fluids, in a scene with both. 1: one step for both, as long as "
+         "the shorter of the fluids' and the particles' stable steps. N > 1: the fluids' step may be up to N "
+         "particle steps long; the particles take as many steps of their own as their elastic wave needs inside "
+         "it, with the fluids' force on them (pressure and exchange) spread evenly over those steps, and the "
+         "fluids see the solids' velocity forecast from each particle's own acceleration of the last step; not "
+         "with `solid_volume: particles` or `coupling: staggered` (doc/mpmice.md, \"Particle steps inside a "
+         "fluid step\").",
+         atLeast(1));
 }
 
 void defineIce(ParameterList& ice)

@@ -783,12 +783,36 @@ KOKKOS_INLINE_FUNCTION void addMovedBox(const double x[Dim], const double l[Dim]
 }  // namespace
 
 template <int Dim>
-void MpmSolver<Dim>::particlesToCells(Field<Dim>& sums, double dt)
+void MpmSolver<Dim>::particlesToCells(Field<Dim>& sums, double dt, bool forecast)
 {
   withShapeFunction([&](auto kernel) {
     using K = decltype(kernel);
-    particlesToCellsWith<K>(sums, dt);
+    particlesToCellsWith<K>(sums, dt, forecast);
   });
+}
+
+template <int Dim>
+void MpmSolver<Dim>::startOwnMotion()
+{
+  const auto v = particles_.velocity;
+  const auto change = particles_.velocity_change;
+  const auto mark = particles_.own_acceleration;  // holds the mark until recordOwnAcceleration
+  Kokkos::parallel_for(
+      "mpm::start_own_motion", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count), KOKKOS_LAMBDA(const int p) {
+        for (int d = 0; d < Dim; ++d) mark(p, d) = v(p, d) + change(p, d);
+      });
+}
+
+template <int Dim>
+void MpmSolver<Dim>::recordOwnAcceleration(double dt)
+{
+  const auto v = particles_.velocity;
+  const auto a = particles_.own_acceleration;
+  Kokkos::parallel_for(
+      "mpm::record_own_acceleration", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count),
+      KOKKOS_LAMBDA(const int p) {
+        for (int d = 0; d < Dim; ++d) a(p, d) = (v(p, d) - a(p, d)) / dt;
+      });
 }
 
 template <int Dim>
@@ -798,6 +822,91 @@ void MpmSolver<Dim>::addCellVelocityChange(const Field<Dim>& change)
     using K = decltype(kernel);
     addCellVelocityChangeWith<K>(change, *node_velocity_star_, true);
   });
+}
+
+template <int Dim>
+void MpmSolver<Dim>::cellVelocityChangeToParticles(const Field<Dim>& change)
+{
+  const int nm = int(materials_.size());
+  const Grid<Dim>& grid = layout_->grid();
+  const MaterialTable table = materialTable(materials_);
+  const auto x = particles_.position;
+  const auto half_width = particles_.half_width;
+  const auto material = particles_.material;
+  const auto dv = particles_.velocity_change;
+  const BoxLookup cells = layout_->cellLookup();
+  const auto du = change.view();
+  double origin[Dim], spacing[Dim];
+  long long count[Dim];
+  for (int d = 0; d < Dim; ++d)
+    origin[d] = grid.lower()[d], spacing[d] = grid.spacing()[d], count[d] = grid.cells()[d];
+  Kokkos::parallel_for(
+      "mpm::cell_velocity_change_to_particles", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count),
+      KOKKOS_LAMBDA(const int p) {
+        const int m = material(p);
+        double xp[Dim], lp[Dim], change_p[Dim] = {};
+        for (int d = 0; d < Dim; ++d) xp[d] = x(p, d), lp[d] = half_width(p, d);
+        if (!table.rigid[m]) {
+          const CellOverlap<Dim> overlap(xp, lp, origin, spacing, count);
+          for (int k = 0; k < overlap.count; ++k) {
+            const LocalOrdinal c = cells(overlap.cell[k][0], overlap.cell[k][1], overlap.cell[k][2]);
+            if (c < 0) continue;
+            for (int d = 0; d < Dim; ++d) change_p[d] += overlap.share[k] * du(c, 2 * nm + m * Dim + d);
+          }
+        }
+        for (int d = 0; d < Dim; ++d) dv(p, d) = change_p[d];
+      });
+}
+
+template <int Dim>
+void MpmSolver<Dim>::addParticleVelocityChange(double fraction)
+{
+  withShapeFunction([&](auto kernel) {
+    using K = decltype(kernel);
+    particleVelocityChangeToNodesWith<K>(fraction);
+  });
+  applyNodeMomentumChange(*node_velocity_star_, true);
+}
+
+template <int Dim>
+template <class Kernel>
+void MpmSolver<Dim>::particleVelocityChangeToNodesWith(double fraction)
+{
+  const int nm = int(materials_.size());
+  if (!node_momentum_change_)
+    node_momentum_change_ =
+        std::make_unique<Field<Dim>>(layout_, Location::Node, std::max(1, nm) * Dim, "mpm node momentum change");
+  node_momentum_change_->fill(0.0);
+  const Grid<Dim>& grid = layout_->grid();
+  const MaterialTable table = materialTable(materials_);
+  const auto x = particles_.position;
+  const auto mass = particles_.mass;
+  const auto half_width = particles_.half_width;
+  const auto material = particles_.material;
+  const auto change = particles_.velocity_change;
+  const BoxLookup nodes = layout_->nodeLookup();
+  const auto dmv = node_momentum_change_->view();
+  double origin[Dim], spacing[Dim];
+  for (int d = 0; d < Dim; ++d) origin[d] = grid.lower()[d], spacing[d] = grid.spacing()[d];
+  const auto scatter = KOKKOS_LAMBDA(const int p)
+  {
+    const int m = material(p);
+    if (table.rigid[m]) return;
+    double xp[Dim], lp[Dim], dv[Dim];
+    for (int d = 0; d < Dim; ++d) xp[d] = x(p, d), lp[d] = half_width(p, d), dv[d] = fraction * change(p, d);
+    ShapeStencil<Dim, Kernel> s;
+    evaluateShape(xp, origin, spacing, lp, s);
+    const double mp = mass(p);
+    for (int k = 0; k < s.size; ++k) {
+      long long node[3] = {0, 0, 0};
+      s.node(k, node);
+      const LocalOrdinal lid = nodes(node[0], node[1], node[2]);
+      if (lid < 0) continue;
+      for (int d = 0; d < Dim; ++d) dmv(lid, m * Dim + d) += s.weight[k] * mp * dv[d];
+    }
+  };
+  forEachParticleScattering("mpm::particle_velocity_change", nodes, scatter);
+  node_momentum_change_->sumToOwners();
 }
 
 template <int Dim>
@@ -811,7 +920,7 @@ void MpmSolver<Dim>::predictCellVolumes(const Field<Dim>& change, double dt, Fie
 
 template <int Dim>
 template <class Kernel>
-void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt)
+void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt, bool forecast)
 {
   const int nm = int(materials_.size());
   if (sums.columns() != cellColumns(nm))
@@ -822,6 +931,8 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt)
   const auto x = particles_.position;
   const auto mass = particles_.mass;
   const auto volume = particles_.volume;
+  const auto v = particles_.velocity;
+  const auto own_acceleration = particles_.own_acceleration;
   const auto half_width = particles_.half_width;
   const auto material = particles_.material;
   const BoxLookup nodes = layout_->nodeLookup();
@@ -839,7 +950,11 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt)
     const int m = material(p);
     double xp[Dim], lp[Dim], velocity[Dim];
     for (int d = 0; d < Dim; ++d) xp[d] = x(p, d), lp[d] = half_width(p, d);
-    particleGridVelocity<Dim, Kernel>(xp, lp, m, table, origin, spacing, nodes, node_vs, velocity);
+    if (forecast && !table.rigid[m]) {
+      for (int d = 0; d < Dim; ++d) velocity[d] = v(p, d) + dt * own_acceleration(p, d);
+    } else {
+      particleGridVelocity<Dim, Kernel>(xp, lp, m, table, origin, spacing, nodes, node_vs, velocity);
+    }
     const CellOverlap<Dim> overlap(xp, lp, origin, spacing, count);
     const double mp = mass(p), Vp = volume(p);
     for (int k = 0; k < overlap.count; ++k) {
@@ -917,20 +1032,21 @@ template <int Dim>
 template <class Kernel>
 void MpmSolver<Dim>::addCellVelocityChangeWith(const Field<Dim>& change, Field<Dim>& target, bool commit)
 {
+  cellVelocityChangeToNodesWith<Kernel>(change);
+  applyNodeMomentumChange(target, commit);
+}
+
+template <int Dim>
+template <class Kernel>
+void MpmSolver<Dim>::cellVelocityChangeToNodesWith(const Field<Dim>& change)
+{
   const int nm = int(materials_.size());
   if (!node_momentum_change_)
     node_momentum_change_ =
         std::make_unique<Field<Dim>>(layout_, Location::Node, std::max(1, nm) * Dim, "mpm node momentum change");
   node_momentum_change_->fill(0.0);
-  if (commit && options_.move_before_coupling) {
-    if (!node_velocity_moved_)
-      node_velocity_moved_ = std::make_unique<Field<Dim>>(layout_, Location::Node, node_velocity_star_->columns(),
-                                                          "mpm node velocity the particles move with");
-    Kokkos::deep_copy(node_velocity_moved_->view(), node_velocity_star_->view());
-  }
   const Grid<Dim>& grid = layout_->grid();
   const MaterialTable table = materialTable(materials_);
-  const NodeColumns col{std::max(1, nm), Dim};
   const auto x = particles_.position;
   const auto mass = particles_.mass;
   const auto half_width = particles_.half_width;
@@ -968,7 +1084,22 @@ void MpmSolver<Dim>::addCellVelocityChangeWith(const Field<Dim>& change, Field<D
   };
   forEachParticleScattering("mpm::cell_velocity_change", nodes, scatter);
   node_momentum_change_->sumToOwners();
+}
 
+template <int Dim>
+void MpmSolver<Dim>::applyNodeMomentumChange(Field<Dim>& target, bool commit)
+{
+  if (!node_momentum_change_) throw std::logic_error("MpmSolver: a node momentum change applied before it was made");
+  if (commit && options_.move_before_coupling) {
+    if (!node_velocity_moved_)
+      node_velocity_moved_ = std::make_unique<Field<Dim>>(layout_, Location::Node, node_velocity_star_->columns(),
+                                                          "mpm node velocity the particles move with");
+    Kokkos::deep_copy(node_velocity_moved_->view(), node_velocity_star_->view());
+  }
+  const int nm = int(materials_.size());
+  const MaterialTable table = materialTable(materials_);
+  const NodeColumns col{std::max(1, nm), Dim};
+  const auto dmv = node_momentum_change_->view();
   const GridConditions<Dim> conditions = gridConditions<Dim>(*layout_, materials_, options_, empty_node_mass_, wall_no_slip_);
   const auto sums = node_sums_->view();
   const auto velocity_star = node_velocity_star_->view();

@@ -153,13 +153,34 @@ class MpmSolver {
   /// With dt > 0 also the volume each material would have in every cell if each particle moved by
   /// Δt ṽ_p (predictedVolumeColumn): how the solids' volumes move in a step before the fluid
   /// pressure acts on them.
-  void particlesToCells(Field<Dim>& sums, double dt = 0.0);
+  /// With `forecast`, ṽ_p is instead the particle's own forecast v_p + Δt a_p (a_p its own
+  /// acceleration of the last coupled step, recordOwnAcceleration; a rigid particle's: its prescribed
+  /// velocity): particle steps inside the fluids' step cannot take a forecast from one grid update
+  /// Δt long, which would be unstable for the particles' elastic wave.
+  void particlesToCells(Field<Dim>& sums, double dt = 0.0, bool forecast = false);
+  /// Own motion over a coupled step with particle steps inside it: startOwnMotion before the
+  /// particle steps marks each particle's velocity plus the velocity change the fluids give it in
+  /// the step (Particles::velocity_change); recordOwnAcceleration after them makes
+  /// Particles::own_acceleration (v_p - mark) / Δt.
+  void startOwnMotion();
+  void recordOwnAcceleration(double dt);
   /// Adds cell velocity changes Δu_c (columns 2 materials + a Dim + d; owned and ghost cells) to the
   /// grid velocity v*: a particle takes Δv_p = Σ_c φ_pc Δu_c with the overlap shares of
   /// particlesToCells, its momentum m_p Δv_p goes to the nodes by its weights, v*_i += Δ(mv)_i / m_i;
   /// then contact and the walls again. The momentum given to the nodes is Σ_c m_c Δu_c exactly (m_c
   /// the cell mass of particlesToCells). Rigid particles take no change.
   void addCellVelocityChange(const Field<Dim>& change);
+  /// addCellVelocityChange in two parts, for particle steps inside one step of the fluids: each
+  /// particle's velocity change Δv_p = Σ_c φ_pc Δu_c from the cells it overlaps now (kept with the
+  /// particle, Particles::velocity_change; zero for rigid particles) ...
+  void cellVelocityChangeToParticles(const Field<Dim>& change);
+  /// ... and `fraction` of it added to the grid velocity of the latest integrateGrid: its momentum
+  /// fraction m_p Δv_p goes to the nodes by the weights of the particle's present position,
+  /// v*_i += Δ(mv)_i / m_i, then contact and the walls again. Called in each of n particle steps
+  /// with fraction 1/n, the particles take Σ_c m_c Δu_c in all, what the fluids gave up, as a force
+  /// held over the fluids' step; with fraction 1 right after cellVelocityChangeToParticles it is
+  /// addCellVelocityChange.
+  void addParticleVelocityChange(double fraction);
   /// Each material's volume in every cell (columns: materials; owned and ghost cells) after a G2P
   /// with the grid velocity v* plus the cell velocity changes `change` (addCellVelocityChange's
   /// columns and rules, walls and contact included), without changing the particles or v*: the
@@ -237,11 +258,17 @@ class MpmSolver {
   template <class Kernel>
   void gridToParticlesWith(double dt);
   template <class Kernel>
-  void particlesToCellsWith(Field<Dim>& sums, double dt);
+  void particlesToCellsWith(Field<Dim>& sums, double dt, bool forecast);
   // Writes v* + the change into `target` (node velocities); `commit`: the step's own change (the
   // staggered coupling's copy of v* and MUSL's constraint record follow it), not a prediction.
   template <class Kernel>
   void addCellVelocityChangeWith(const Field<Dim>& change, Field<Dim>& target, bool commit);
+  template <class Kernel>
+  void cellVelocityChangeToNodesWith(const Field<Dim>& change);
+  template <class Kernel>
+  void particleVelocityChangeToNodesWith(double fraction);
+  /// v_i += Δ(mv)_i / m_i (node_momentum_change_) into target, then contact and the walls.
+  void applyNodeMomentumChange(Field<Dim>& target, bool commit);
   template <class Kernel>
   void predictCellVolumesWith(const Field<Dim>& change, double dt, Field<Dim>& volumes);
   /// f(p) for every particle, for kernels that add into node arrays: in index order on one thread;

@@ -25,6 +25,8 @@ void Particles<Dim>::resize(int n)
       half_width = VectorView("particle half-width", grown);
       id = Kokkos::View<long long*, MemorySpace>("particle id", grown);
       velocity_gradient = TensorView("particle velocity gradient", grown);
+      velocity_change = VectorView("particle velocity change", grown);
+      own_acceleration = VectorView("particle own acceleration", grown);
     } else {
       Kokkos::resize(position, grown);
       Kokkos::resize(velocity, grown);
@@ -38,6 +40,8 @@ void Particles<Dim>::resize(int n)
       Kokkos::resize(half_width, grown);
       Kokkos::resize(id, grown);
       Kokkos::resize(velocity_gradient, grown);
+      Kokkos::resize(velocity_change, grown);
+      Kokkos::resize(own_acceleration, grown);
     }
   }
   count = n;

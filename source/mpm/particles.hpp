@@ -23,7 +23,7 @@ struct Particles {
 
   /// Doubles per particle in a migration buffer (pack / unpack); material and id travel as
   /// doubles, exact for ids below 2^53.
-  static constexpr int kPackedSize = 3 * Dim + 3 + 2 * Dim * Dim + 3 + 2;
+  static constexpr int kPackedSize = 3 * Dim + 3 + 2 * Dim * Dim + 3 + 2 * Dim + 2;
 
   int count = 0;  ///< particles in use: entries [0, count)
 
@@ -38,6 +38,14 @@ struct Particles {
   Kokkos::View<int*, MemorySpace> material;         ///< MPM material index (SolidMaterial list)
   VectorView half_width;            ///< uGIMP particle half-width l_p per direction (m)
   Kokkos::View<long long*, MemorySpace> id;         ///< unique, independent of the decomposition
+  /// The velocity change the fluids gave the particle in the present coupled step (m/s), which its
+  /// particle steps inside that step take in equal parts (MpmSolver::addParticleVelocityChange);
+  /// migrated with the particle, since it moves to other ranks between those steps.
+  VectorView velocity_change;
+  /// With particle steps inside the fluids' step: the particle's own acceleration (its stress,
+  /// gravity, contact; not the fluids' force) over the last coupled step (m/s^2), from which the
+  /// next step forecasts its velocity for the fluids (MpmSolver::particlesToCells); migrated.
+  VectorView own_acceleration;
   /// Velocity gradient of the last step (1/s); scratch between G2P and the stress update, not
   /// migrated.
   TensorView velocity_gradient;
@@ -55,6 +63,8 @@ struct Particles {
       position(to, d) = position(from, d);
       velocity(to, d) = velocity(from, d);
       half_width(to, d) = half_width(from, d);
+      velocity_change(to, d) = velocity_change(from, d);
+      own_acceleration(to, d) = own_acceleration(from, d);
       for (int e = 0; e < Dim; ++e) {
         deformation_gradient(to, d, e) = deformation_gradient(from, d, e);
         stress(to, d, e) = stress(from, d, e);
@@ -85,6 +95,8 @@ struct Particles {
     row[k++] = state(p).out_of_plane_stress;
     row[k++] = state(p).equivalent_plastic_strain;
     row[k++] = state(p).volumetric_plastic_strain;
+    for (int d = 0; d < Dim; ++d) row[k++] = velocity_change(p, d);
+    for (int d = 0; d < Dim; ++d) row[k++] = own_acceleration(p, d);
     row[k++] = double(material(p));
     row[k++] = double(id(p));
   }
@@ -106,6 +118,8 @@ struct Particles {
     state(p).out_of_plane_stress = row[k++];
     state(p).equivalent_plastic_strain = row[k++];
     state(p).volumetric_plastic_strain = row[k++];
+    for (int d = 0; d < Dim; ++d) velocity_change(p, d) = row[k++];
+    for (int d = 0; d < Dim; ++d) own_acceleration(p, d) = row[k++];
     material(p) = int(row[k++]);
     id(p) = static_cast<long long>(row[k++]);
   }

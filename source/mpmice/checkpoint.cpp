@@ -30,9 +30,11 @@ std::string particleColumns()
   for (const char* tensor : {"deformation_gradient", "stress"})
     for (int d = 0; d < Dim; ++d)
       for (int e = 0; e < Dim; ++e) add(std::string(tensor) + "_" + xyz[d] + xyz[e]);
-  for (const char* scalar : {"out_of_plane_stress", "equivalent_plastic_strain", "volumetric_plastic_strain",
-                             "material", "id"})
+  for (const char* scalar : {"out_of_plane_stress", "equivalent_plastic_strain", "volumetric_plastic_strain"})
     add(scalar);
+  for (int d = 0; d < Dim; ++d) add(std::string("velocity_change_") + xyz[d]);
+  for (int d = 0; d < Dim; ++d) add(std::string("own_acceleration_") + xyz[d]);
+  for (const char* scalar : {"material", "id"}) add(scalar);
   return names;
 }
 

@@ -52,6 +52,7 @@ MpmIceStep<Dim>::MpmIceStep(const Scene& scene, std::shared_ptr<const Layout<Dim
     mpm_->particlesToGrid();
     mpm_->integrateGrid(0.0);  // v* = v: the particles' velocities on the grid, walls applied
     cellsFromParticles(state, 0.0);
+    particle_forecast_ = scene.mpm.substeps > 1;
     fillAroundSolids(scene, densityFunctions(scene), state);
   }
   if (ice_ && mpm_ && scene.mpm.solid_volume == "particles") {
@@ -86,13 +87,25 @@ CoupledStepReport MpmIceStep<Dim>::step(CellState<Dim>& state, double dt)
 {
   CoupledStepReport report;
   Teuchos::TimeMonitor whole(*timers_.at("step"));
+  // With mpm.substeps > 1 the particles take as many steps inside this one as their own stable
+  // step needs (stableTimeStep allowed the fluids' step to be up to `substeps` of them long).
+  if (ice_ && mpm_ && scene_.mpm.substeps > 1) {
+    const double particle_dt = mpm_->stableTimeStep().dt;
+    if (std::isfinite(particle_dt) && particle_dt > 0)
+      report.particle_steps = std::max(1, int(std::ceil(dt / particle_dt * (1.0 - 1e-12))));
+  }
+  const int particle_steps = report.particle_steps;
 
   // 1. Particles to nodes: mass, momentum, the skeleton stress's force and gravity; v* with contact
-  //    between solids and the walls.
+  //    between solids and the walls: the solids' velocity at the end of the step before the fluids
+  //    act, from which the fluids' phases take the solids' velocity and volume change. With particle
+  //    steps inside this one (mpm.substeps > 1) a grid update over the whole step would overshoot
+  //    the particles' elastic wave; that forecast is each particle's velocity plus Δt times its own
+  //    acceleration of the last step instead (2.), and the particle steps (9.) move the particles.
   if (mpm_) {
     Teuchos::TimeMonitor phase(*timers_.at("1 particles to grid"));
     mpm_->particlesToGrid();
-    mpm_->integrateGrid(dt);
+    if (!particle_forecast_) mpm_->integrateGrid(dt);
   }
   // 2. The solids' mass, volume and velocity v* in every cell.
   if (ice_ && mpm_) {
@@ -147,16 +160,27 @@ CoupledStepReport MpmIceStep<Dim>::step(CellState<Dim>& state, double dt)
     }
   }
   // 9. The solids' velocity change from the pressure force and the exchange back to the nodes;
-  //    grid to particles; stress update; particles to their ranks.
+  //    grid to particles; stress update; particles to their ranks. With n particle steps in this
+  //    one, each takes its own grid velocity from its particles and 1/n of the nodes' momentum
+  //    change: the fluids' force on the solids is held over the step, and the particles take in
+  //    all what the fluids gave up (doc/mpmice.md, "Particle steps inside a fluid step").
   if (mpm_) {
     Teuchos::TimeMonitor phase(*timers_.at("9 grid to particles"));
     if (ice_) {
       velocityChange(state);
-      mpm_->addCellVelocityChange(*cell_change_);
+      mpm_->cellVelocityChangeToParticles(*cell_change_);
     }
-    mpm_->gridToParticles(dt);
-    mpm_->updateStress(dt);
-    mpm_->relocateParticles();
+    if (particle_forecast_) mpm_->startOwnMotion();
+    const double particle_dt = dt / particle_steps;
+    for (int k = 0; k < particle_steps; ++k) {
+      if (k > 0) mpm_->particlesToGrid();
+      if (particle_steps > 1 || particle_forecast_) mpm_->integrateGrid(particle_dt);
+      if (ice_) mpm_->addParticleVelocityChange(1.0 / particle_steps);
+      mpm_->gridToParticles(particle_dt);
+      mpm_->updateStress(particle_dt);
+      mpm_->relocateParticles();
+    }
+    if (particle_forecast_) mpm_->recordOwnAcceleration(dt);
   }
   // 10. Advection of the fluids.
   if (ice_) {
@@ -257,7 +281,7 @@ Kokkos::Array<int, ice::kMaxMaterials> MpmIceStep<Dim>::solidSceneIndices() cons
 template <int Dim>
 void MpmIceStep<Dim>::cellsFromParticles(CellState<Dim>& state, double dt)
 {
-  mpm_->particlesToCells(*cell_sums_, dt);
+  mpm_->particlesToCells(*cell_sums_, dt, particle_forecast_);
   const int nm = int(mpm_->materials().size());
   const auto scene_index = solidSceneIndices();
   const double volume = layout_->grid().cellVolume();
@@ -342,8 +366,12 @@ TimeStepLimit MpmIceStep<Dim>::stableTimeStep(const CellState<Dim>& state, doubl
   TimeStepLimit limit{scene_.time.dt_max, "dt_max"};
   if (ice_) limit = ice_->stableTimeStep(state, previous_dt);
   if (mpm_) {
+    // With particle steps inside the fluids' step, the step may be `substeps` particle steps long.
     const mpm::MpmTimeStep particles = mpm_->stableTimeStep();
-    if (particles.dt < limit.dt) limit = {particles.dt, "wave_speed(" + particles.material + ")"};
+    const int substeps = ice_ ? scene_.mpm.substeps : 1;
+    if (substeps * particles.dt < limit.dt)
+      limit = {substeps * particles.dt,
+               (substeps > 1 ? std::to_string(substeps) + " x " : std::string()) + "wave_speed(" + particles.material + ")"};
   }
   return limit;
 }

@@ -187,6 +187,7 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
     physics_columns.insert(physics_columns.end(), {"equilibration_failures", "equilibration_jump", "exchange_failures", "pressure_converged"});
   }
   if (has_particles) {
+    if (fluids_move) physics_columns.push_back("particle_steps");
     physics_columns.push_back("particles");
     for (const auto& m : scene.materials)
       if (m.kind == "solid") physics_columns.push_back("mass_" + m.name);
@@ -206,6 +207,7 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
                              CsvValue(r.converged ? 1 : 0)});
     }
     if (const mpm::MpmSolver<Dim>* particles = run_state.step->particles()) {
+      if (fluids_move) row.emplace_back(step_report.particle_steps);
       row.emplace_back(particles->particleCount());
       for (double m : particles->materialMasses()) row.emplace_back(m);
       const auto p = particles->momentum();

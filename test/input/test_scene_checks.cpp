@@ -166,6 +166,14 @@ TEST_F(SceneTest, SolidVolumeFromParticlesNeedsTheMonolithicImplicitPressure)
   expectMentions(errorOf(replaced(kFullScene, "  mpm: {}\n", "  mpm: {solid_volume: nodes}\n")),
                  {"cfdmpm.mpm.solid_volume", "nodes", "faces", "particles"});
   EXPECT_NO_THROW(readScene(write(replaced(kFullScene, "  mpm: {}\n", "  mpm: {solid_volume: particles}\n"))));
+  // Particle steps inside the fluids' step need the monolithic coupling and the solids' volume from
+  // their face velocities.
+  expectMentions(errorOf(replaced(kFullScene, "  mpm: {}\n", "  mpm: {substeps: 4, coupling: staggered}\n")),
+                 {"cfdmpm.mpm.substeps", "4", "monolithic"});
+  expectMentions(errorOf(replaced(kFullScene, "  mpm: {}\n", "  mpm: {substeps: 4, solid_volume: particles}\n")),
+                 {"cfdmpm.mpm.substeps", "4", "faces"});
+  expectMentions(errorOf(replaced(kFullScene, "  mpm: {}\n", "  mpm: {substeps: 0}\n")), {"cfdmpm.mpm.substeps", "0"});
+  EXPECT_NO_THROW(readScene(write(replaced(kFullScene, "  mpm: {}\n", "  mpm: {substeps: 4}\n"))));
 }
 
 TEST_F(SceneTest, HydrostaticWithGravityOffAxisIsRefusedWithTheScene)

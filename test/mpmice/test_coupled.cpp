@@ -81,8 +81,9 @@ TEST(CoupledStep, NeutrallyBuoyantBlockStaysPut)
 // 3 %: the sloshing's and the pore pressure's deviations at the base (±10 Pa measured inside the
 // block against the water beside it, 2 % of the 590 Pa buoyant weight there) and the air's
 // expansion (below).
-// extra_mpm: more keys of the wet run's mpm section.
-void expectSandBlockRestsOnItsBuoyantWeight(const std::string& extra_mpm)
+// extra_mpm: more keys of the wet run's mpm section. Returns the most particle steps the wet run
+// took in one step.
+int expectSandBlockRestsOnItsBuoyantWeight(const std::string& extra_mpm)
 {
   const double rho_s = 2000.0, rho_w = 1000.0;
   const std::string block = "    b: {material: block, shape: box, lower: [0.05, 0.0], upper: [0.15, 0.06]}";
@@ -113,7 +114,9 @@ void expectSandBlockRestsOnItsBuoyantWeight(const std::string& extra_mpm)
                                             "  mpm: {velocity_damping: 100.0" + extra_mpm + "}")),
                     world());
   double stress_sum = 0, samples = 0, speed = 0;
+  int particle_steps = 1;
   run.runUntil(0.4, [&] {
+    particle_steps = std::max(particle_steps, run.last.particle_steps);
     if (run.time > 0.3) {
       stress_sum += baseStress(run), samples += 1;
       speed = std::max(speed, run.maxParticleSpeed(0));
@@ -129,9 +132,17 @@ void expectSandBlockRestsOnItsBuoyantWeight(const std::string& extra_mpm)
   // At rest but for the sloshing: slower than a free fall over one damping time, g / α = 0.1 m/s,
   // by two orders of magnitude.
   EXPECT_LT(speed, 1e-3 * 9.81);
+  return particle_steps;
 }
 
-TEST(CoupledStep, SandBlockRestsOnItsBuoyantWeight) { expectSandBlockRestsOnItsBuoyantWeight(""); }
+TEST(CoupledStep, SandBlockRestsOnItsBuoyantWeight) { EXPECT_EQ(expectSandBlockRestsOnItsBuoyantWeight(""), 1); }
+
+// The same with up to four particle steps in each step of the fluids (mpm.substeps: 4): the fluids'
+// force on the block, spread over its particle steps, carries the same share of its weight.
+TEST(CoupledStep, ParticleStepsInsideAFluidStepKeepTheBlocksBuoyantWeight)
+{
+  EXPECT_GE(expectSandBlockRestsOnItsBuoyantWeight(", substeps: 4"), 2);
+}
 
 // The same with the solids' volume from their particles (mpm.solid_volume: particles): the pressure
 // equation's view of the block changes, its load must not.
@@ -246,7 +257,9 @@ TEST(CoupledStep, PlungerRaisesTheLevelByTheDisplacedVolume)
 // implicit pressure reaches the walls at once), to round-off: the exchange, the pressure force on
 // each material and its way back to the particles, and the advection conserve momentum. The walls'
 // impulse is summed from the pressure of each step's momentum phase on the boundary cells.
-TEST(CoupledStep, ExchangeConservesMomentum)
+// extra_mpm: an `mpm` section for the scene, or empty. Returns (total change - wall impulse) / the
+// disk's initial momentum, and the most particle steps taken in one step.
+std::pair<double, int> exchangeMomentumBalance(const std::string& extra_mpm)
 {
   const char* disk = R"(    disk:
       kind: solid
@@ -261,7 +274,7 @@ TEST(CoupledStep, ExchangeConservesMomentum)
     x+: {velocity: free_slip}
     y-: {velocity: free_slip}
     y+: {velocity: free_slip}
-  ice: {exchange_coefficient: 1.0e15})";
+  ice: {exchange_coefficient: 1.0e15})" + extra_mpm;
   // Inviscid: the viscous force θ_m μ_m ∇²u of each material is not a divergence where θ varies (at
   // the disk's edge it moves ~1e-6 of the disk's momentum in these 100 steps); the rest is exact.
   std::string text = tankScene(1.0, 1.0, 40, 40, 1.0, disk, regions, extra, 0.0);
@@ -272,9 +285,11 @@ TEST(CoupledStep, ExchangeConservesMomentum)
   const auto total = [&] { return run.fluidMomentum(water, 0) + run.particles().momentum()[0]; };
   const double disk0 = run.particles().momentum()[0], start = total();
   double impulse = 0;
+  int particle_steps = 1;
   const auto boundary = run.layout->cellIndex();
   for (int k = 0; k < 100; ++k) {
     run.step(1.0);
+    particle_steps = std::max(particle_steps, run.last.particle_steps);
     // Wall pressure on the x- wall pushes +x, on the x+ wall -x (per metre of depth: p h per cell).
     const auto p = run.state.pressure.view();
     double local = 0;
@@ -290,7 +305,23 @@ TEST(CoupledStep, ExchangeConservesMomentum)
     std::printf("disk momentum %.6f -> %.6f kg m/s per m; total change %.3e, wall impulse %.3e\n", disk0, disk1,
                 end - start, impulse);
   EXPECT_LT(disk1, 0.99 * disk0);  // slowed by the water (added mass alone takes a third of it)
-  EXPECT_NEAR(end - start, impulse, 1e-10 * std::abs(disk0));
+  return {(end - start - impulse) / std::abs(disk0), particle_steps};
+}
+
+TEST(CoupledStep, ExchangeConservesMomentum)
+{
+  const auto [imbalance, particle_steps] = exchangeMomentumBalance("");
+  EXPECT_EQ(particle_steps, 1);
+  EXPECT_NEAR(imbalance, 0.0, 1e-10);
+}
+
+// The same with up to four particle steps in each step of the fluids (mpm.substeps: 4).
+TEST(CoupledStep, ParticleStepsInsideAFluidStepConserveMomentum)
+{
+  const auto [imbalance, particle_steps] = exchangeMomentumBalance("\n  mpm: {substeps: 4}");
+  if (world()->getRank() == 0) std::printf("momentum imbalance %.3e of the disk's, up to %d particle steps per step\n", imbalance, particle_steps);
+  EXPECT_GE(particle_steps, 2);
+  EXPECT_NEAR(imbalance, 0.0, 1e-10);
 }
 
 // No silent failures: a cell whose materials admit no common pressure (here air at a temperature

@@ -1032,58 +1032,9 @@ template <int Dim>
 template <class Kernel>
 void MpmSolver<Dim>::addCellVelocityChangeWith(const Field<Dim>& change, Field<Dim>& target, bool commit)
 {
-  cellVelocityChangeToNodesWith<Kernel>(change);
+  cellVelocityChangeToParticles(change);
+  particleVelocityChangeToNodesWith<Kernel>(1.0);
   applyNodeMomentumChange(target, commit);
-}
-
-template <int Dim>
-template <class Kernel>
-void MpmSolver<Dim>::cellVelocityChangeToNodesWith(const Field<Dim>& change)
-{
-  const int nm = int(materials_.size());
-  if (!node_momentum_change_)
-    node_momentum_change_ =
-        std::make_unique<Field<Dim>>(layout_, Location::Node, std::max(1, nm) * Dim, "mpm node momentum change");
-  node_momentum_change_->fill(0.0);
-  const Grid<Dim>& grid = layout_->grid();
-  const MaterialTable table = materialTable(materials_);
-  const auto x = particles_.position;
-  const auto mass = particles_.mass;
-  const auto half_width = particles_.half_width;
-  const auto material = particles_.material;
-  const BoxLookup nodes = layout_->nodeLookup();
-  const BoxLookup cells = layout_->cellLookup();
-  const auto du = change.view();
-  const auto dmv = node_momentum_change_->view();
-  double origin[Dim], spacing[Dim];
-  long long count[Dim];
-  for (int d = 0; d < Dim; ++d)
-    origin[d] = grid.lower()[d], spacing[d] = grid.spacing()[d], count[d] = grid.cells()[d];
-  const auto scatter = KOKKOS_LAMBDA(const int p)
-  {
-    const int m = material(p);
-    if (table.rigid[m]) return;
-    double xp[Dim], lp[Dim], dv[Dim] = {};
-    for (int d = 0; d < Dim; ++d) xp[d] = x(p, d), lp[d] = half_width(p, d);
-    const CellOverlap<Dim> overlap(xp, lp, origin, spacing, count);
-    for (int k = 0; k < overlap.count; ++k) {
-      const LocalOrdinal c = cells(overlap.cell[k][0], overlap.cell[k][1], overlap.cell[k][2]);
-      if (c < 0) continue;
-      for (int d = 0; d < Dim; ++d) dv[d] += overlap.share[k] * du(c, 2 * nm + m * Dim + d);
-    }
-    ShapeStencil<Dim, Kernel> s;
-    evaluateShape(xp, origin, spacing, lp, s);
-    const double mp = mass(p);
-    for (int k = 0; k < s.size; ++k) {
-      long long node[3] = {0, 0, 0};
-      s.node(k, node);
-      const LocalOrdinal lid = nodes(node[0], node[1], node[2]);
-      if (lid < 0) continue;
-      for (int d = 0; d < Dim; ++d) dmv(lid, m * Dim + d) += s.weight[k] * mp * dv[d];
-    }
-  };
-  forEachParticleScattering("mpm::cell_velocity_change", nodes, scatter);
-  node_momentum_change_->sumToOwners();
 }
 
 template <int Dim>

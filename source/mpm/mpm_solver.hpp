@@ -183,8 +183,10 @@ class MpmSolver {
   void addParticleVelocityChange(double fraction);
   /// Each material's volume in every cell (columns: materials; owned and ghost cells) after a G2P
   /// with the grid velocity v* plus the cell velocity changes `change` (addCellVelocityChange's
-  /// columns and rules, walls and contact included), without changing the particles or v*: the
-  /// boxes of particlesToCells at x_p + Δt Σ_i w_ip v_i, with the particles' present volumes.
+  /// columns and rules, walls and contact included), without moving the particles or changing v*
+  /// (it leaves the change in Particles::velocity_change, which the step's own
+  /// cellVelocityChangeToParticles replaces): the boxes of particlesToCells at
+  /// x_p + Δt Σ_i w_ip v_i, with the particles' present volumes.
   void predictCellVolumes(const Field<Dim>& change, double dt, Field<Dim>& volumes);
 
   // --- undoing a step (the driver retries a failed step with a smaller Δt) ------------------------
@@ -263,8 +265,6 @@ class MpmSolver {
   // staggered coupling's copy of v* and MUSL's constraint record follow it), not a prediction.
   template <class Kernel>
   void addCellVelocityChangeWith(const Field<Dim>& change, Field<Dim>& target, bool commit);
-  template <class Kernel>
-  void cellVelocityChangeToNodesWith(const Field<Dim>& change);
   template <class Kernel>
   void particleVelocityChangeToNodesWith(double fraction);
   /// v_i += Δ(mv)_i / m_i (node_momentum_change_) into target, then contact and the walls.

@@ -52,7 +52,7 @@ MpmIceStep<Dim>::MpmIceStep(const Scene& scene, std::shared_ptr<const Layout<Dim
     mpm_->particlesToGrid();
     mpm_->integrateGrid(0.0);  // v* = v: the particles' velocities on the grid, walls applied
     cellsFromParticles(state, 0.0);
-    particle_forecast_ = scene.mpm.substeps > 1;
+    substeps_ = scene.mpm.substeps;  // after the first cell sums, which take v* (integrateGrid(0))
     fillAroundSolids(scene, densityFunctions(scene), state);
   }
   if (ice_ && mpm_ && scene.mpm.solid_volume == "particles") {
@@ -89,7 +89,7 @@ CoupledStepReport MpmIceStep<Dim>::step(CellState<Dim>& state, double dt)
   Teuchos::TimeMonitor whole(*timers_.at("step"));
   // With mpm.substeps > 1 the particles take as many steps inside this one as their own stable
   // step needs (stableTimeStep allowed the fluids' step to be up to `substeps` of them long).
-  if (ice_ && mpm_ && scene_.mpm.substeps > 1) {
+  if (substeps_ > 1) {
     const double particle_dt = mpm_->stableTimeStep().dt;
     if (std::isfinite(particle_dt) && particle_dt > 0)
       report.particle_steps = std::max(1, int(std::ceil(dt / particle_dt * (1.0 - 1e-12))));
@@ -105,7 +105,7 @@ CoupledStepReport MpmIceStep<Dim>::step(CellState<Dim>& state, double dt)
   if (mpm_) {
     Teuchos::TimeMonitor phase(*timers_.at("1 particles to grid"));
     mpm_->particlesToGrid();
-    if (!particle_forecast_) mpm_->integrateGrid(dt);
+    if (substeps_ == 1) mpm_->integrateGrid(dt);
   }
   // 2. The solids' mass, volume and velocity v* in every cell.
   if (ice_ && mpm_) {
@@ -170,17 +170,17 @@ CoupledStepReport MpmIceStep<Dim>::step(CellState<Dim>& state, double dt)
       velocityChange(state);
       mpm_->cellVelocityChangeToParticles(*cell_change_);
     }
-    if (particle_forecast_) mpm_->startOwnMotion();
+    if (substeps_ > 1) mpm_->startOwnMotion();
     const double particle_dt = dt / particle_steps;
     for (int k = 0; k < particle_steps; ++k) {
       if (k > 0) mpm_->particlesToGrid();
-      if (particle_steps > 1 || particle_forecast_) mpm_->integrateGrid(particle_dt);
+      if (substeps_ > 1) mpm_->integrateGrid(particle_dt);  // else step 1's, Δt long
       if (ice_) mpm_->addParticleVelocityChange(1.0 / particle_steps);
       mpm_->gridToParticles(particle_dt);
       mpm_->updateStress(particle_dt);
       mpm_->relocateParticles();
     }
-    if (particle_forecast_) mpm_->recordOwnAcceleration(dt);
+    if (substeps_ > 1) mpm_->recordOwnAcceleration(dt);
   }
   // 10. Advection of the fluids.
   if (ice_) {
@@ -281,7 +281,7 @@ Kokkos::Array<int, ice::kMaxMaterials> MpmIceStep<Dim>::solidSceneIndices() cons
 template <int Dim>
 void MpmIceStep<Dim>::cellsFromParticles(CellState<Dim>& state, double dt)
 {
-  mpm_->particlesToCells(*cell_sums_, dt, particle_forecast_);
+  mpm_->particlesToCells(*cell_sums_, dt, substeps_ > 1);
   const int nm = int(mpm_->materials().size());
   const auto scene_index = solidSceneIndices();
   const double volume = layout_->grid().cellVolume();
@@ -368,10 +368,9 @@ TimeStepLimit MpmIceStep<Dim>::stableTimeStep(const CellState<Dim>& state, doubl
   if (mpm_) {
     // With particle steps inside the fluids' step, the step may be `substeps` particle steps long.
     const mpm::MpmTimeStep particles = mpm_->stableTimeStep();
-    const int substeps = ice_ ? scene_.mpm.substeps : 1;
-    if (substeps * particles.dt < limit.dt)
-      limit = {substeps * particles.dt,
-               (substeps > 1 ? std::to_string(substeps) + " x " : std::string()) + "wave_speed(" + particles.material + ")"};
+    if (substeps_ * particles.dt < limit.dt)
+      limit = {substeps_ * particles.dt,
+               (substeps_ > 1 ? std::to_string(substeps_) + " x " : std::string()) + "wave_speed(" + particles.material + ")"};
   }
   return limit;
 }

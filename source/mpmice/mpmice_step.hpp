@@ -100,9 +100,10 @@ class MpmIceStep {
   std::unique_ptr<Field<Dim>> cell_sums_;       // particlesToCells: mass, volume, momentum per solid
   std::unique_ptr<Field<Dim>> cell_change_;     // velocity change of the solids' cells (same columns)
   std::unique_ptr<Field<Dim>> solid_velocity_;  // the solids' cell velocity from the particles
-  /// mpm.substeps > 1: the solids' velocity forecast for the fluids comes from each particle's own
-  /// acceleration of the last step (MpmSolver::particlesToCells), not from one grid update.
-  bool particle_forecast_ = false;
+  /// Most particle steps in one step (mpm.substeps with fluids and particles, else 1). Above 1 the
+  /// solids' velocity forecast for the fluids comes from each particle's own acceleration of the
+  /// last step (MpmSolver::particlesToCells), not from one grid update.
+  int substeps_ = 1;
   std::unique_ptr<Field<Dim>> predicted_volume_;  // predictSolidVolumes: each solid's volume per cell
   std::unique_ptr<CellState<Dim>> trial_state_;    // predictSolidVolumes: the state the trial phases change
   std::map<std::string, Teuchos::RCP<Teuchos::Time>> timers_;

@@ -1170,7 +1170,10 @@ void IceSolver<Dim>::pressurePhase(CellState<Dim>& state, double dt, IceStepRepo
     fluidFaceFractions(state, dt);
     carriedFaceBeta(1);
   }
-  if (implicit) pressure_solver_->assemble(mixture_compressibility_, face_beta_, dt);
+  if (implicit) {
+    secantSlopeWhereBoiling(state);
+    pressure_solver_->assemble(mixture_compressibility_, face_beta_, dt);
+  }
   const bool predicted = bool(solid_volume_predictor_) && roles_.any_solid && implicit;
   const bool refresh_fractions = roles_.any_solid && implicit;
   if (predicted) solid_volume_predictor_(state, dt);
@@ -1277,6 +1280,48 @@ void IceSolver<Dim>::pressurePhase(CellState<Dim>& state, double dt, IceStepRepo
   }
 
 
+}
+
+// Water that boils at the equilibration pressure has the vapour's slope, 1/p (~1e-3 /Pa against
+// the liquid's 4.7e-10), but only as long as its vapour lasts: the vapour is a share 1 − ρ/ρ_c of
+// the cell (1e-4 .. 1e-2 in the slide), and once it is gone the liquid is stiff again. The first
+// solve with the tangent takes such a cell for nearly as soft as a gas, raises its pressure by a
+// few hundred Pa where the step needs ~1e5, and leaves up to half of the cell unmatched (the slide
+// at 10 mm from 0.3 s on: 0.4-0.6 of a cell after every first solve), which a further outer
+// iteration must take up. Where a fluid boils and the cell's pressure was higher at the end of the
+// last step, the first matrix takes the secant of the volume law from the equilibration pressure
+// to that pressure, the rise the step most likely makes; the later iterations follow the tangent
+// at the pressure reached (followCompressibility). Other materials in the cell keep θ κ.
+template <int Dim>
+void IceSolver<Dim>::secantSlopeWhereBoiling(const CellState<Dim>& state)
+{
+  bool boils = false;
+  for (int m = 0; m < materials_; ++m)
+    boils = boils || (eos_[m].kind == ice::EosKind::LinearWater && eos_[m].linear_water.cavitation_pressure > 0);
+  if (!boils) return;
+  const int n = materials_;
+  const auto theta = state.volume_fraction.view();
+  const auto kappa = compressibility_.view();
+  const auto p_eq = equilibrium_pressure_.view();
+  const auto previous = delta_p_.view();  // the last step's pressure (equilibrationPhase)
+  const auto T = state.temperature.view();
+  const auto eos = eos_;
+  auto sum_kappa = mixture_compressibility_.view();
+  Kokkos::parallel_for(
+      "ice::secantSlopeWhereBoiling", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+      KOKKOS_LAMBDA(const LocalOrdinal c) {
+        const double rise = previous(c, 0) - p_eq(c, 0);
+        if (!(rise > 0)) return;
+        bool boiling = false;
+        for (int m = 0; m < n; ++m) boiling = boiling || (theta(c, m) > 0 && cavitating(eos[m], p_eq(c, 0)));
+        if (!boiling) return;
+        double sk = 0;
+        for (int m = 0; m < n; ++m)
+          sk += cavitating(eos[m], p_eq(c, 0))
+                    ? theta(c, m) * materialVolumeLoss(eos[m], p_eq(c, 0), T(c, m), kappa(c, m), rise) / rise
+                    : theta(c, m) * kappa(c, m);
+        sum_kappa(c, 0) = sk;
+      });
 }
 
 template <int Dim>

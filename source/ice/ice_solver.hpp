@@ -206,6 +206,7 @@ class IceSolver {
   // Σ_m θ_m κ_m s'(κ_m Σδp) into mixture_compressibility_ where that is more than
   // kCompressibilityChange below it somewhere; returns whether it wrote (then reassemble).
   bool followCompressibility(const CellState<Dim>& state);
+  void secantSlopeWhereBoiling(const CellState<Dim>& state);
   void fluidFaceFractions(const CellState<Dim>& state, double dt);
   void energy(CellState<Dim>& state, const Field<Dim>& old_specific_volume, double dt);
 

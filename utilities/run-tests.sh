@@ -1,9 +1,8 @@
 #!/usr/bin/env bash
 # Builds cfdmpm (installing dependencies when missing) and runs the whole test suite with ctest.
 # Extra arguments go to ctest (e.g. -R ice). A plain ctest runs the default suite: the benchmarks
-# (label "bench"), the long validation and stability runs ("validation", "stability") and coupled
-# cases that do not pass yet ("coupled-open": the sand column, the plunger) opt in by label
-# (`utilities/run-tests.sh -L validation` runs the validation runs only); see test/opt_in/.
+# (label "bench") and the long validation and stability runs ("validation", "stability") opt in by
+# label (`utilities/run-tests.sh -L validation` runs the validation runs only); see test/opt_in/.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 "$root/utilities/setup.sh"

@@ -779,6 +779,8 @@ void IceSolver<Dim>::momentumSourcePhase(CellState<Dim>& state, double dt)
   const auto mu = viscosity_;
   const auto roles = roles_;
   const bool with_solids = roles_.any_solid;
+  typename Field<Dim>::ConstView share[3];
+  for (int d = 0; d < Dim; ++d) share[d] = solid_face_share_.direction(d).view();
   double h[3], inverse_h2[3], g[3];
   int no_slip[6];
   for (int d = 0; d < Dim; ++d) {
@@ -831,6 +833,16 @@ void IceSolver<Dim>::momentumSourcePhase(CellState<Dim>& state, double dt)
               return mass > 0 && volume > 0 ? mass / volume : 0.0;
             };
             const double rho_c = fluidDensity(c);
+            // The share of the face between `upper` and the cell below it in direction d that the
+            // rigid bodies close (their larger share of its two sides, as in faceVelocities).
+            const auto rigidClosedShare = [&](int d, LocalOrdinal upper) {
+              double closed = 0;
+              for (int m = 0; m < nm; ++m)
+                if (roles.rigid[m])
+                  closed += Kokkos::Experimental::fmax(Kokkos::Experimental::fmin(1.0, share[d](upper, 2 * m)),
+                                                       Kokkos::Experimental::fmin(1.0, share[d](upper, 2 * m + 1)));
+              return Kokkos::Experimental::fmin(1.0, closed);
+            };
             // The pressure that acts: the cell's own where its fluids set it, the reference where a
             // deformable solid fills it (kPoreShareLow).
             const auto acting = [&](LocalOrdinal cell) {
@@ -851,13 +863,19 @@ void IceSolver<Dim>::momentumSourcePhase(CellState<Dim>& state, double dt)
               bool extrapolate[2] = {false, false};
               for (int side = 0; side < 2; ++side) {
                 const LocalOrdinal o = neighbour[2 * d + side];
-                if (o < 0) {
-                  face_p[side] = p_c + (side == 0 ? -0.5 : 0.5) * h[d] * rho_c * g[d];
+                const double wall = p_c + (side == 0 ? -0.5 : 0.5) * h[d] * rho_c * g[d];
+                // The share of the face a rigid body closes is a wall (faceVelocities lets no
+                // fluid through it): the pressure of a cell the body fills, set by its trace of
+                // fluid and the body's stiffness, does not reach the fluid beside it.
+                const double closed = o < 0 ? 1.0 : rigidClosedShare(d, side == 0 ? c : o);
+                if (closed >= 1.0) {
+                  face_p[side] = wall;
                   extrapolate[side] = !(rho_c > 0);
                   continue;
                 }
                 const double rho_o = fluidDensity(o), p_o = acting(o);
-                face_p[side] = rho_c > 0 && rho_o > 0 ? (p_o * rho_c + p_c * rho_o) / (rho_c + rho_o) : 0.5 * (p_o + p_c);
+                const double across = rho_c > 0 && rho_o > 0 ? (p_o * rho_c + p_c * rho_o) / (rho_c + rho_o) : 0.5 * (p_o + p_c);
+                face_p[side] = closed > 0 && rho_c > 0 ? closed * wall + (1.0 - closed) * across : across;
               }
               if (extrapolate[0] && !extrapolate[1]) face_p[0] = 2.0 * p_c - face_p[1];
               if (extrapolate[1] && !extrapolate[0]) face_p[1] = 2.0 * p_c - face_p[0];

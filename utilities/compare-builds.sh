@@ -2,7 +2,12 @@
 # The same scenes on the Serial build (one rank) and on the OpenMP build (one rank of
 # OMP_NUM_THREADS threads, default 2), compared field by field with utilities/compare_runs.py:
 #   - the dam break, 50 x 20 cells to 0.05 s, pressure solved to a relative residual of 1e-12;
-#   - the dry granular column (Drucker-Prager sand), 160 x 60 cells to 0.02 s.
+#   - the dry granular column (Drucker-Prager sand), 160 x 60 cells to 0.02 s;
+#   - the coupled seed scene (input/rzadkiewicz.yaml: sand, rigid bed, water, air) at 20 mm to
+#     0.05 s, pressure solved to 1e-12, on one rank of the Serial build and of the OpenMP build
+#     with 1 thread and with OMP_NUM_THREADS; the two OpenMP runs are compared with each other
+#     as well (1 against 2 threads: the same free surface and particle positions to 1e-8 of their
+#     scales, as the 1-vs-2-rank test of the coupled step asks).
 # Threads change only the order of sums: reductions (dot products in CG, diagnostics) and the
 # particle-to-grid scatter (tile colour by tile colour on threads). Each differs from the serial
 # sum by round-off (~1e-16 relative);
@@ -23,6 +28,10 @@ sed -e "s|cells: \[200, 80\]|cells: [50, 20]|" -e "s|patch_cells: \[25, 20\]|pat
     "$root/input/dam-break.yaml" > "$work/dam-break.yaml"
 sed -e "s|end_time: 0.4|end_time: 0.02|" -e "s|interval: 0.05|interval: 0.01|" \
     "$root/input/granular-column.yaml" > "$work/granular-column.yaml"
+sed -e "s|^    cell_size: 0.01 .*|    cell_size: 0.02|" -e "s|    end_time: 0.8|    end_time: 0.05|" \
+    -e "s|^    interval: 0.05|    interval: 0.025|" -e "s|^    outer_tolerance: 1.0e-7|&\n    solver_tolerance: 1.0e-12|" \
+    "$root/input/rzadkiewicz.yaml" > "$work/rzadkiewicz.yaml"
+grep -q "solver_tolerance: 1.0e-12" "$work/rzadkiewicz.yaml"
 status=0
 for scene in dam-break granular-column; do
   for build in serial omp; do
@@ -35,4 +44,20 @@ for scene in dam-break granular-column; do
   echo "$scene: Serial build vs OpenMP build with $threads threads"
   /usr/bin/python3 "$root/utilities/compare_runs.py" "$work/$scene-serial" "$work/$scene-omp" --tolerance 1e-10 || status=1
 done
+# The coupled scene: Serial, OpenMP on 1 thread, OpenMP on $threads threads.
+scene=rzadkiewicz
+for run in serial omp1 omp; do
+  sed "s|directory: .*|directory: $work/$scene-$run|" "$work/$scene.yaml" > "$work/$scene-$run.yaml"
+done
+mpiexec -n 1 "$serial/cfdmpm" "$work/$scene-serial.yaml" > "$work/$scene-serial.log"
+for run in omp1 omp; do
+  n=$([ "$run" = omp1 ] && echo 1 || echo "$threads")
+  OMP_NUM_THREADS=$n OMP_PROC_BIND=spread OMP_PLACES=threads \
+    mpiexec -n 1 --map-by "slot:PE=$n" -x OMP_NUM_THREADS -x OMP_PROC_BIND -x OMP_PLACES \
+    "$omp/cfdmpm" "$work/$scene-$run.yaml" > "$work/$scene-$run.log"
+done
+echo "$scene: OpenMP build, 1 thread vs $threads threads"
+/usr/bin/python3 "$root/utilities/compare_runs.py" "$work/$scene-omp1" "$work/$scene-omp" --tolerance 1e-8 || status=1
+echo "$scene: Serial build vs OpenMP build with $threads threads"
+/usr/bin/python3 "$root/utilities/compare_runs.py" "$work/$scene-serial" "$work/$scene-omp" --tolerance 1e-8 || status=1
 exit $status

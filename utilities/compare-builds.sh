@@ -32,15 +32,19 @@ sed -e "s|^    cell_size: 0.01 .*|    cell_size: 0.02|" -e "s|    end_time: 0.8|
     -e "s|^    interval: 0.05|    interval: 0.025|" -e "s|^    outer_tolerance: 1.0e-7|&\n    solver_tolerance: 1.0e-12|" \
     "$root/input/rzadkiewicz.yaml" > "$work/rzadkiewicz.yaml"
 grep -q "solver_tolerance: 1.0e-12" "$work/rzadkiewicz.yaml"
+# run_omp N NAME: the OpenMP build on one rank of N threads, scene $work/NAME.yaml, log NAME.log.
+run_omp() {
+  OMP_NUM_THREADS=$1 OMP_PROC_BIND=spread OMP_PLACES=threads \
+    mpiexec -n 1 --map-by "slot:PE=$1" -x OMP_NUM_THREADS -x OMP_PROC_BIND -x OMP_PLACES \
+    "$omp/cfdmpm" "$work/$2.yaml" > "$work/$2.log"
+}
 status=0
 for scene in dam-break granular-column; do
   for build in serial omp; do
     sed "s|directory: .*|directory: $work/$scene-$build|" "$work/$scene.yaml" > "$work/$scene-$build.yaml"
   done
   mpiexec -n 1 "$serial/cfdmpm" "$work/$scene-serial.yaml" > "$work/$scene-serial.log"
-  OMP_NUM_THREADS=$threads OMP_PROC_BIND=spread OMP_PLACES=threads \
-    mpiexec -n 1 --map-by "slot:PE=$threads" -x OMP_NUM_THREADS -x OMP_PROC_BIND -x OMP_PLACES \
-    "$omp/cfdmpm" "$work/$scene-omp.yaml" > "$work/$scene-omp.log"
+  run_omp "$threads" "$scene-omp"
   echo "$scene: Serial build vs OpenMP build with $threads threads"
   /usr/bin/python3 "$root/utilities/compare_runs.py" "$work/$scene-serial" "$work/$scene-omp" --tolerance 1e-10 || status=1
 done
@@ -50,12 +54,8 @@ for run in serial omp1 omp; do
   sed "s|directory: .*|directory: $work/$scene-$run|" "$work/$scene.yaml" > "$work/$scene-$run.yaml"
 done
 mpiexec -n 1 "$serial/cfdmpm" "$work/$scene-serial.yaml" > "$work/$scene-serial.log"
-for run in omp1 omp; do
-  n=$([ "$run" = omp1 ] && echo 1 || echo "$threads")
-  OMP_NUM_THREADS=$n OMP_PROC_BIND=spread OMP_PLACES=threads \
-    mpiexec -n 1 --map-by "slot:PE=$n" -x OMP_NUM_THREADS -x OMP_PROC_BIND -x OMP_PLACES \
-    "$omp/cfdmpm" "$work/$scene-$run.yaml" > "$work/$scene-$run.log"
-done
+run_omp 1 "$scene-omp1"
+run_omp "$threads" "$scene-omp"
 echo "$scene: OpenMP build, 1 thread vs $threads threads"
 /usr/bin/python3 "$root/utilities/compare_runs.py" "$work/$scene-omp1" "$work/$scene-omp" --tolerance 1e-8 || status=1
 echo "$scene: Serial build vs OpenMP build with $threads threads"

@@ -132,6 +132,22 @@ ice::ExchangeCoefficients pairCoefficients(double coefficient, int materials, co
   return K;
 }
 
+// The share of a face that the rigid materials close: each closes its larger share of the face's
+// two sides (`share` of the face's upper cell: column 2 m just below the face, 2 m + 1 just above),
+// summed and at most 1. The face velocities let no fluid through it, and the momentum phase's face
+// pressure takes it as a wall.
+template <class Shares>
+KOKKOS_INLINE_FUNCTION double rigidClosedShare(int materials, const MaterialRoles& roles, const Shares& share,
+                                               LocalOrdinal upper)
+{
+  double closed = 0;
+  for (int m = 0; m < materials; ++m)
+    if (roles.rigid[m])
+      closed += Kokkos::Experimental::fmax(Kokkos::Experimental::fmin(1.0, share(upper, 2 * m)),
+                                           Kokkos::Experimental::fmin(1.0, share(upper, 2 * m + 1)));
+  return Kokkos::Experimental::fmin(1.0, closed);
+}
+
 // Calls f(std::integral_constant<int, N>()): N = 2 for two materials, so that the kernels' loops over
 // materials have constant bounds (and the exchange takes its two-material form), else N = 0 (the
 // count is read at run time).
@@ -479,10 +495,7 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
             // the time its box covers the face in the step (MpmSolver::particlesToCells), so the
             // fluids cross what it opens (behind it) or what it has not closed yet (ahead of it) at
             // its speed. It keeps its own face velocity and takes no pressure correction.
-            double closed = 0;
-            for (int m = 0; m < nm; ++m)
-              if (roles.rigid[m]) closed += Kokkos::Experimental::fmax(fl[m], fr[m]);
-            const double open = closed < 1.0 ? 1.0 - closed : 0.0;
+            const double open = with_solids ? 1.0 - rigidClosedShare(nm, roles, share, c) : 1.0;
             const double mixture = momentum / (weight + kTiny);
             const double mixture_sv = weight > 0 ? specific_volume / weight : b;
             for (int m = 0; m < nm; ++m) {
@@ -833,16 +846,6 @@ void IceSolver<Dim>::momentumSourcePhase(CellState<Dim>& state, double dt)
               return mass > 0 && volume > 0 ? mass / volume : 0.0;
             };
             const double rho_c = fluidDensity(c);
-            // The share of the face between `upper` and the cell below it in direction d that the
-            // rigid bodies close (their larger share of its two sides, as in faceVelocities).
-            const auto rigidClosedShare = [&](int d, LocalOrdinal upper) {
-              double closed = 0;
-              for (int m = 0; m < nm; ++m)
-                if (roles.rigid[m])
-                  closed += Kokkos::Experimental::fmax(Kokkos::Experimental::fmin(1.0, share[d](upper, 2 * m)),
-                                                       Kokkos::Experimental::fmin(1.0, share[d](upper, 2 * m + 1)));
-              return Kokkos::Experimental::fmin(1.0, closed);
-            };
             // The pressure that acts: the cell's own where its fluids set it, the reference where a
             // deformable solid fills it (kPoreShareLow).
             const auto acting = [&](LocalOrdinal cell) {
@@ -867,7 +870,7 @@ void IceSolver<Dim>::momentumSourcePhase(CellState<Dim>& state, double dt)
                 // The share of the face a rigid body closes is a wall (faceVelocities lets no
                 // fluid through it): the pressure of a cell the body fills, set by its trace of
                 // fluid and the body's stiffness, does not reach the fluid beside it.
-                const double closed = o < 0 ? 1.0 : rigidClosedShare(d, side == 0 ? c : o);
+                const double closed = o < 0 ? 1.0 : rigidClosedShare(nm, roles, share[d], side == 0 ? c : o);
                 if (closed >= 1.0) {
                   face_p[side] = wall;
                   extrapolate[side] = !(rho_c > 0);

@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <iostream>
 #include <string>
 
@@ -59,6 +60,15 @@ struct CommandLine {
 
 /// Writes a message with one write() call, so that the lines of ranks failing together do not
 /// interleave within a line (writes of up to PIPE_BUF bytes to a pipe are atomic).
+// Whether two paths name the same directory (either may not exist yet).
+bool sameDirectory(const std::string& a, const std::string& b)
+{
+  std::error_code error;
+  const auto ca = std::filesystem::weakly_canonical(a, error);
+  const auto cb = std::filesystem::weakly_canonical(b, error);
+  return error ? a == b : ca == cb;
+}
+
 void writeError(const std::string& message)
 {
   const std::string text = message.back() == '\n' ? message : message + "\n";
@@ -152,6 +162,12 @@ int main(int argc, char** argv)
         scene = cfdmpm::readScene(command.scene);
         cfdmpm::checkRestartScene(scene, stored);
       }
+      // The given scene's output directory is not used: say so before the restart trims the
+      // checkpoint's directory to the checkpoint's step (doc/output.md).
+      if (!command.scene.empty() && root && !sameDirectory(scene.output.directory, header.output_directory))
+        std::cout << "cfdmpm: the restart continues in " << header.output_directory
+                  << ", the checkpoint's output directory, removing what that run wrote after the checkpoint; "
+                  << command.scene << "'s output.directory '" << scene.output.directory << "' is not used\n";
       scene.output.directory = header.output_directory;
       command.options.restart_checkpoint = checkpoint;
       command.options.run_name = header.run_name;

@@ -358,6 +358,7 @@ LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, d
   const auto bounds = bounds_;
   const auto slab_density = slab_density_;
   const int materials = materials_;
+  const unsigned held = options_.held_materials;
   const LocalOrdinal owned = layout_->ownedCells();
 
   // Per cell (owned and ghost, so that every owned face has its donor) and material, the slab
@@ -377,6 +378,8 @@ LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, d
       KOKKOS_LAMBDA(int c, LargestOutflow& best) {
         const auto local = stencil.local(c);
         for (int m = 0; m < materials; ++m) {
+          // A held material: update() skips it and its slab densities keep their initial 0.
+          if (held >> m & 1u) continue;
           if (M(c, m) == 0.0) {
             if (c < owned) best.include(slabs.totalOutflowFraction(c, m, local.neighbour), stencil.globalId(c) * materials + m);
             // No mass of m here: nothing leaves (masses are >= 0, so the block's lower bound is 0
@@ -481,6 +484,7 @@ void Advector<Dim>::update(Field<Dim>& mass, const std::vector<Field<Dim>*>& mas
   const auto q = quantityColumns<Dim, kMaxFields, typename Field<Dim>::View>(mass_specific, materials_);
   auto M = mass.view();
   const int materials = materials_;
+  const unsigned held = options_.held_materials;
 
   // Each face's flux is one stored number, read by the donor (out) and by the receiver (in). Per
   // column, (M q)_new = M q - Σ_out F q_out + Σ_in F q_in, written as an increment of q so that zero
@@ -491,6 +495,7 @@ void Advector<Dim>::update(Field<Dim>& mass, const std::vector<Field<Dim>*>& mas
         LocalOrdinal neighbour[2 * Dim];
         for (int f = 0; f < 2 * Dim; ++f) neighbour[f] = neighbours(c, f);
         for (int m = 0; m < materials; ++m) {
+          if (held >> m & 1u) continue;  // mass and quantities as they are
           double mass_new = M(c, m);
           double out[2 * Dim], in[2 * Dim];  // the slab masses leaving and entering through each face
           for (int f = 0; f < 2 * Dim; ++f) {

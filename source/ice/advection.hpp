@@ -54,6 +54,11 @@ class Advector {
     /// the donor's mean transverse velocity (corner transport). Off: the centroid of the
     /// rectangular slab, as Uintah; then diagonal flows are first order in time (see the doc).
     bool transverse_correction = true;
+    /// Bit m set: material m does not move (the coupled step's solids, which their particles
+    /// carry). advect() leaves its mass and quantities as they are and slabDensities() gives 0
+    /// for it, without computing their profiles (a third of the cell-material pairs of the seed
+    /// scene are its bed and sand).
+    unsigned held_materials = 0;
   };
 
   /// Work arrays for `materials` materials on the layout's cells are allocated here, once.

@@ -41,7 +41,7 @@ struct IceSettings {
   std::string pressure;                  // "implicit" or "explicit" (for comparison)
   double exchange_coefficient = 0;       // momentum exchange K between every pair (kg/(m^3 s))
   int max_outer_iterations = 0;
-  double outer_tolerance = 0;            // on max |rhs| / V_cell of the pressure equation (dimensionless)
+  double outer_tolerance = 0;            // on the pressure equation's residual, a volume share (IceSolver::pressureRightHandSide)
   double solver_tolerance = 0;           // relative residual of each linear solve (when given)
   bool solver_tolerance_given = false;   // false: each solve goes as far as the outer test needs
   double dt_growth = 0;                  // largest ratio of successive time steps
@@ -228,6 +228,9 @@ class IceSolver {
   }
   ice::MaterialArray<ice::Eos> eos_;
   ice::MaterialArray<double> bulk_modulus_;  // solids: K of their equation of state (Pa)
+  // The stiffest fluid's compressibility at the initial pressure and temperature (1/Pa): the outer
+  // test weighs each cell's volume residual by how much softer than that the cell is.
+  double stiffest_compressibility_ = 0;
   ice::MaterialArray<double> viscosity_;
   ice::MaterialArray<double> specific_heat_;
   ice::MaterialArray<double> conductivity_;

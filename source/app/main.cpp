@@ -58,8 +58,6 @@ struct CommandLine {
   bool check_only = false;
 };
 
-/// Writes a message with one write() call, so that the lines of ranks failing together do not
-/// interleave within a line (writes of up to PIPE_BUF bytes to a pipe are atomic).
 // Whether two paths name the same directory (either may not exist yet).
 bool sameDirectory(const std::string& a, const std::string& b)
 {
@@ -69,6 +67,8 @@ bool sameDirectory(const std::string& a, const std::string& b)
   return error ? a == b : ca == cb;
 }
 
+/// Writes a message with one write() call, so that the lines of ranks failing together do not
+/// interleave within a line (writes of up to PIPE_BUF bytes to a pipe are atomic).
 void writeError(const std::string& message)
 {
   const std::string text = message.back() == '\n' ? message : message + "\n";

@@ -1419,21 +1419,8 @@ template <int Dim>
 void IceSolver<Dim>::advectionPhase(CellState<Dim>& state, double dt, IceStepReport& report)
 {
   Teuchos::TimeMonitor phase(*timers_.at("advection"));
-  if (roles_.any_solid) {
-    const int n = materials_;
-    unsigned lagrangian = 0;  // bit m: material m is a solid
-    for (int m = 0; m < n; ++m)
-      if (roles_.lagrangian[m]) lagrangian |= 1u << m;
-    for (int d = 0; d < Dim; ++d) {
-      auto uf = face_velocity_.direction(d).view();
-      Kokkos::parallel_for(
-          "ice::holdSolids", Kokkos::RangePolicy<ExecutionSpace>(0, state.density.overlapCount()),
-          KOKKOS_LAMBDA(const LocalOrdinal c) {
-            for (int m = 0; m < n; ++m)
-              if (lagrangian >> m & 1u) uf(c, m) = 0.0;
-          });
-    }
-  }
+  // The solids stay where their particles put them: the advector holds them (its held_materials,
+  // set in the constructor) and reads none of their face velocities.
   std::vector<Field<Dim>*> carried{&state.velocity, &state.specific_volume};
   if (!settings_.isothermal) carried.push_back(&state.temperature);  // c_v T is the energy per mass
   const AdvectionStatus advected = advector_->advect(face_velocity_, dt, state.density, carried, fluid_outflow_share_);

@@ -243,6 +243,7 @@ class IceSolver {
   Field<Dim> mixture_compressibility_;  // Σθκ (1/Pa)
   Field<Dim> equilibrium_pressure_;
   Field<Dim> delta_p_, sum_delta_p_, rhs_;
+  Field<Dim> outer_weight_;  // the outer test's weight of each cell's volume residual (pressureRightHandSide)
   FaceField<Dim> face_velocity_;        // per material
   FaceField<Dim> corrected_face_velocity_;  // work array of the pressure correction
   FaceField<Dim> face_specific_volume_; // per material, after the face exchange

@@ -6,8 +6,11 @@
 #include "common/mpi_comm.hpp"
 #include "input/parameter_rule.hpp"
 
+#include <BelosCGIter.hpp>
 #include <BelosLinearProblem.hpp>
-#include <BelosPseudoBlockCGSolMgr.hpp>
+#include <BelosStatusTestCombo.hpp>
+#include <BelosStatusTestGenResNorm.hpp>
+#include <BelosStatusTestMaxIters.hpp>
 #include <BelosTpetraAdapter.hpp>
 #include <MueLu_CreateTpetraPreconditioner.hpp>
 #include <Teuchos_CommHelpers.hpp>
@@ -153,14 +156,52 @@ struct LowerFaceValues {
   KOKKOS_INLINE_FUNCTION Scalar operator()(int d, LocalOrdinal c) const { return direction[d](c, 0); }
 };
 
-/// ||v||₂ or max_i |v_i| (Belos::TwoNorm or Belos::InfNorm) over all ranks.
-double vectorNorm(const MultiVector& v, Belos::NormType norm)
-{
-  double value = 0;
-  if (norm == Belos::InfNorm) v.normInf(Teuchos::ArrayView<double>(&value, 1));
-  else v.norm2(Teuchos::ArrayView<double>(&value, 1));
-  return value;
-}
+/// How a solve measures a residual: ||v||₂, max_i |v_i|, or max_i w_i |v_i| with the caller's
+/// weights w (a row whose residual matters less to the caller counts for less).
+struct ResidualMeasure {
+  Belos::NormType norm = Belos::TwoNorm;
+  Teuchos::RCP<const Vector> weight;  // with norm = InfNorm only
+  Teuchos::RCP<MultiVector> scratch;  // w ⊙ v
+
+  double operator()(const MultiVector& v) const
+  {
+    double value = 0;
+    if (!weight.is_null()) {
+      scratch->elementWiseMultiply(1.0, *weight, v, 0.0);
+      scratch->normInf(Teuchos::ArrayView<double>(&value, 1));
+    } else if (norm == Belos::InfNorm) {
+      v.normInf(Teuchos::ArrayView<double>(&value, 1));
+    } else {
+      v.norm2(Teuchos::ArrayView<double>(&value, 1));
+    }
+    return value;
+  }
+};
+
+/// Belos stopping test on CG's recurrence residual in a ResidualMeasure: passed once it is at most
+/// `bound`. (Belos's own residual test knows no weights.)
+class ResidualBoundTest : public Belos::StatusTest<Scalar, MultiVector, Operator> {
+ public:
+  ResidualBoundTest(const ResidualMeasure& measure, double bound) : measure_(measure), bound_(bound) {}
+  Belos::StatusType checkStatus(Belos::Iteration<Scalar, MultiVector, Operator>* iteration) override
+  {
+    value_ = measure_(*iteration->getNativeResiduals(nullptr));
+    status_ = value_ <= bound_ ? Belos::Passed : Belos::Failed;
+    return status_;
+  }
+  Belos::StatusType getStatus() const override { return status_; }
+  void reset() override { status_ = Belos::Undefined; }
+  void print(std::ostream& os, int indent) const override
+  {
+    os << std::string(indent, ' ') << "residual " << value_ << " (bound " << bound_ << "): " << status_ << "\n";
+  }
+
+ private:
+  const ResidualMeasure& measure_;
+  double bound_;
+  double value_ = 0;
+  Belos::StatusType status_ = Belos::Undefined;
+};
 
 void requireOneColumn(int columns, const std::string& name, const char* role)
 {
@@ -185,8 +226,8 @@ struct PressureSolver<Dim>::Impl {
   Kokkos::View<std::size_t**, MemorySpace> stencil_offsets;
   static constexpr std::size_t kNoEntry = ~std::size_t(0);
 
-  // Work vectors of solve(), allocated once (a residual and the caller's guess).
-  Teuchos::RCP<MultiVector> residual, guess;
+  // Work vectors of solve(), allocated once (a residual, the caller's guess, a weighted residual).
+  Teuchos::RCP<MultiVector> residual, guess, weighted;
 
   // Cumulative wall time of the parts of the solve, for profiling (bench/bench_ice).
   Teuchos::RCP<Teuchos::Time> assemble_timer = Teuchos::TimeMonitor::getNewCounter("pressure solver: assemble");
@@ -212,9 +253,9 @@ struct PressureSolver<Dim>::Impl {
   void buildGraph();
   Teuchos::ParameterList mueluParameters() const;
   Teuchos::RCP<Operator> preparePreconditioner(PressureSolveReport& report);
-  double residualNorm(const MultiVector& b, const MultiVector& x, Belos::NormType norm) const;
-  void runCG(const Teuchos::RCP<Operator>& preconditioner, const MultiVector& b, MultiVector& x, Belos::NormType norm,
-             double b_norm, double tolerance, PressureSolveReport& report) const;
+  double residualNorm(const MultiVector& b, const MultiVector& x, const ResidualMeasure& measure) const;
+  void runCG(const Teuchos::RCP<Operator>& preconditioner, const MultiVector& b, MultiVector& x,
+             const ResidualMeasure& measure, double b_norm, double tolerance, PressureSolveReport& report) const;
 };
 
 template <int Dim>
@@ -352,56 +393,62 @@ Teuchos::RCP<Operator> PressureSolver<Dim>::Impl::preparePreconditioner(Pressure
 }
 
 template <int Dim>
-double PressureSolver<Dim>::Impl::residualNorm(const MultiVector& b, const MultiVector& x, Belos::NormType norm) const
+double PressureSolver<Dim>::Impl::residualNorm(const MultiVector& b, const MultiVector& x,
+                                               const ResidualMeasure& measure) const
 {
   MultiVector& r = *residual;
   r.assign(b);
   matrix->apply(x, r, Teuchos::NO_TRANS, -1.0, 1.0);  // r = b - A x
-  return vectorNorm(r, norm);
+  return measure(r);
 }
 
-/// Belos CG on A x = b from the current x, adding to the report: it stops when ||b − A x|| <=
-/// tolerance ||b|| in the given norm (b_norm = ||b||). Belos's stopping test uses the recurrence
-/// residual, which can drift from the true one; if they disagree we restart from the current iterate
-/// (a restart recomputes the residual), at most twice, within the iteration budget.
+/// CG (Belos's CG iteration) on A x = b from the current x, adding to the report: it stops when the
+/// residual's measure is at most tolerance b_norm (b_norm: the measure of b). The stopping test
+/// reads CG's recurrence residual, which can drift from the true one; if they disagree we restart
+/// from the current iterate (a restart recomputes the residual), at most twice, within the iteration
+/// budget. The preconditioner is applied on the right: Belos's CG applies a left or a right one the
+/// same way (z = M^-1 r), but LinearProblem::setProblem() also computes the left-preconditioned
+/// initial residual, which CG never reads, so on the right MueLu runs one V-cycle fewer per solve.
 template <int Dim>
 void PressureSolver<Dim>::Impl::runCG(const Teuchos::RCP<Operator>& preconditioner, const MultiVector& b,
-                                      MultiVector& x, Belos::NormType norm, double b_norm, double tolerance,
-                                      PressureSolveReport& report) const
+                                      MultiVector& x, const ResidualMeasure& measure, double b_norm,
+                                      double tolerance, PressureSolveReport& report) const
 {
-  auto problem = Teuchos::rcp(new Belos::LinearProblem<Scalar, MultiVector, Operator>(
-      matrix, Teuchos::rcpFromRef(x), Teuchos::rcpFromRef(b)));
-  // Belos's CG applies a left or a right preconditioner the same way (z = M^-1 r), but
-  // LinearProblem::setProblem() also computes the left-preconditioned initial residual, which CG
-  // never reads: as a right preconditioner MueLu runs one V-cycle fewer per solve.
+  using Problem = Belos::LinearProblem<Scalar, MultiVector, Operator>;
+  using Combo = Belos::StatusTestCombo<Scalar, MultiVector, Operator>;
+  auto problem = Teuchos::rcp(new Problem(matrix, Teuchos::rcpFromRef(x), Teuchos::rcpFromRef(b)));
   if (!preconditioner.is_null()) problem->setRightPrec(preconditioner);
-  int verbosity = Belos::Errors + Belos::Warnings;
-  if (settings.verbosity >= 2) verbosity += Belos::IterationDetails + Belos::FinalSummary + Belos::StatusTestDetails;
+  auto printer = Teuchos::rcp(new Belos::OutputManager<Scalar>(Belos::Errors + Belos::Warnings));
+  const bool trace = settings.verbosity >= 2 && layout->comm()->getRank() == 0;
   int iterations = 0;
   for (int attempt = 0; attempt < 3; ++attempt) {
-    auto belos = Teuchos::rcp(new Teuchos::ParameterList);
-    // Belos scales the residual by ||b|| only in the 2-norm, so the test is given as the absolute
-    // bound tolerance ||b|| (unscaled), in the norm set on the status test below.
-    belos->set("Convergence Tolerance", tolerance * b_norm);
-    belos->set("Maximum Iterations", settings.maximum_iterations - iterations);
-    belos->set("Implicit Residual Scaling", std::string("None"));
-    belos->set("Verbosity", verbosity);
-    belos->set("Output Style", int(Belos::Brief));
-    belos->set("Output Frequency", settings.verbosity >= 2 ? 1 : -1);
     problem->setProblem();  // residual of the current iterate
-    Belos::PseudoBlockCGSolMgr<Scalar, MultiVector, Operator> cg(problem, belos);
-    cg.getResidualStatusTest()->defineResForm(Belos::StatusTestGenResNorm<Scalar, MultiVector, Operator>::Implicit,
-                                              norm);
-    Belos::ReturnType result = Belos::Unconverged;
+    problem->setLSIndex(std::vector<int>{0});
+    auto bound = Teuchos::rcp(new ResidualBoundTest(measure, tolerance * b_norm));
+    auto budget = Teuchos::rcp(
+        new Belos::StatusTestMaxIters<Scalar, MultiVector, Operator>(settings.maximum_iterations - iterations));
+    auto test = Teuchos::rcp(new Combo(Combo::OR, budget, bound));
+    Teuchos::ParameterList options;  // asserts positive definiteness (Belos's default)
+    Belos::CGIter<Scalar, MultiVector, Operator> cg(problem, printer, test, Teuchos::null, options);
+    Belos::CGIterationState<Scalar, MultiVector> state;
+    state.R = problem->getInitResVec();
+    bool reached = false;
     try {
-      result = cg.solve();
+      cg.initializeCG(state);
+      cg.iterate();
+      reached = bound->getStatus() == Belos::Passed;
     } catch (const std::exception& e) {  // loss of positive definiteness, for one
       report.failure = e.what();
     }
+    problem->setCurrLS();
     iterations += cg.getNumIters();
-    report.relative_residual = residualNorm(b, x, norm) / b_norm;
+    report.relative_residual = residualNorm(b, x, measure) / b_norm;
     report.converged = report.relative_residual <= tolerance;
-    if (report.converged || result != Belos::Converged || iterations >= settings.maximum_iterations) break;
+    if (trace) {
+      std::cout << "  CG: " << cg.getNumIters() << " iterations, recurrence test ";
+      bound->print(std::cout, 0);
+    }
+    if (report.converged || !reached || iterations >= settings.maximum_iterations) break;
   }
   report.iterations += iterations;
 }
@@ -563,7 +610,8 @@ void PressureSolver<Dim>::apply(const Field<Dim>& x, Field<Dim>& y) const
 }
 
 template <int Dim>
-PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>& solution, double residual_target, int kind)
+PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>& solution, double residual_target,
+                                               int kind, const Field<Dim>* residual_weight)
 {
   Impl& m = *impl_;
   if (!m.assembled) throw std::logic_error("PressureSolver::solve before assemble");
@@ -575,10 +623,22 @@ PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>
 
   const MultiVector& b = rhs.owned();
   MultiVector& x = solution.owned();
-  // The norm of the stopping test: the 2-norm, or with an absolute target the largest entry (the
-  // caller bounds every cell's residual, and the 2-norm can exceed it by up to sqrt(cells)).
-  const Belos::NormType norm = residual_target > 0 ? Belos::InfNorm : Belos::TwoNorm;
-  const double b_norm = vectorNorm(b, norm);
+  if (m.residual.is_null()) {
+    m.residual = Teuchos::rcp(new MultiVector(b.getMap(), 1, false));
+    m.guess = Teuchos::rcp(new MultiVector(b.getMap(), 1, false));
+    m.weighted = Teuchos::rcp(new MultiVector(b.getMap(), 1, false));
+  }
+  // The measure of the stopping test: the 2-norm, or with an absolute target the largest entry (the
+  // caller bounds every cell's residual, and the 2-norm can exceed it by up to sqrt(cells)), each
+  // entry times the caller's weight if there is one.
+  ResidualMeasure measure;
+  measure.norm = residual_target > 0 ? Belos::InfNorm : Belos::TwoNorm;
+  if (residual_target > 0 && residual_weight) {
+    requireOneColumn(residual_weight->columns(), residual_weight->name(), "residual weight");
+    measure.weight = residual_weight->owned().getVector(0);
+    measure.scratch = m.weighted;
+  }
+  const double b_norm = measure(b);
   if (b_norm == 0) {  // A is SPD, so the answer is exactly zero
     x.putScalar(0);
     solution.exchangeHalo();
@@ -588,10 +648,6 @@ PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>
   // The relative tolerance of this solve: the settings' one, or looser when the caller's absolute
   // target allows it (never looser than 0.5: CG must reduce the residual at all).
   report.tolerance = std::min(std::max(s.tolerance, residual_target / b_norm), 0.5);
-  if (m.residual.is_null()) {
-    m.residual = Teuchos::rcp(new MultiVector(b.getMap(), 1, false));
-    m.guess = Teuchos::rcp(new MultiVector(b.getMap(), 1, false));
-  }
 
   // 1. Preconditioner: built, refreshed or reused.
   Clock::time_point start = Clock::now();
@@ -608,7 +664,7 @@ PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>
   start = Clock::now();
   {
     Teuchos::TimeMonitor timer(*m.cg_timer);
-    m.runCG(preconditioner, b, x, norm, b_norm, report.tolerance, report);
+    m.runCG(preconditioner, b, x, measure, b_norm, report.tolerance, report);
   }
   report.solve_seconds = secondsSince(start);
 
@@ -628,7 +684,7 @@ PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>
     report.failure.clear();
     {
       Teuchos::TimeMonitor timer(*m.cg_timer);
-      m.runCG(preconditioner, b, x, norm, b_norm, report.tolerance, report);
+      m.runCG(preconditioner, b, x, measure, b_norm, report.tolerance, report);
     }
     report.solve_seconds += secondsSince(start);
   }

@@ -94,7 +94,12 @@ class PressureSolver {
   /// solves differ in character (the ICE outer iteration: a first solve of a step reduces its
   /// residual by ~6 decades, a correction solve by ~4, in fewer iterations per decade) passes which
   /// is which; otherwise every first solve looks slowed down against the last correction solve.
-  PressureSolveReport solve(const Field<Dim>& rhs, Field<Dim>& solution, double residual_target = 0, int kind = 0);
+  /// residual_weight (1 column, > 0, owned rows read; used with residual_target > 0 only): each
+  /// cell's entry of the residual and of rhs in that test is multiplied by its weight, for a caller
+  /// whose own test weighs the cells (the ICE outer test: a cell softer than water needs its volume
+  /// matched less closely); the report's relative residual is then the weighted one.
+  PressureSolveReport solve(const Field<Dim>& rhs, Field<Dim>& solution, double residual_target = 0, int kind = 0,
+                            const Field<Dim>* residual_weight = nullptr);
   static constexpr int kSolveKinds = 4;
 
   /// y = A x on the owned cells (x's ghosts are not read; y's ghosts are not written).

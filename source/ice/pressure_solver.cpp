@@ -179,26 +179,34 @@ struct ResidualMeasure {
 };
 
 /// Belos stopping test on CG's recurrence residual in a ResidualMeasure: passed once it is at most
-/// `bound`. (Belos's own residual test knows no weights.)
+/// `bound` (Belos's own residual test knows no weights). With `trace` it prints every check.
 class ResidualBoundTest : public Belos::StatusTest<Scalar, MultiVector, Operator> {
  public:
-  ResidualBoundTest(const ResidualMeasure& measure, double bound) : measure_(measure), bound_(bound) {}
+  ResidualBoundTest(const ResidualMeasure& measure, double bound, bool trace)
+      : measure_(measure), bound_(bound), trace_(trace)
+  {
+  }
   Belos::StatusType checkStatus(Belos::Iteration<Scalar, MultiVector, Operator>* iteration) override
   {
     value_ = measure_(*iteration->getNativeResiduals(nullptr));
     status_ = value_ <= bound_ ? Belos::Passed : Belos::Failed;
+    if (trace_) {
+      std::cout << "  CG iteration " << iteration->getNumIters() << ": ";
+      print(std::cout, 0);
+    }
     return status_;
   }
   Belos::StatusType getStatus() const override { return status_; }
   void reset() override { status_ = Belos::Undefined; }
   void print(std::ostream& os, int indent) const override
   {
-    os << std::string(indent, ' ') << "residual " << value_ << " (bound " << bound_ << "): " << status_ << "\n";
+    os << std::string(indent, ' ') << "residual " << value_ << " (bound " << bound_ << "): " << Belos::convertStatusTypeToString(status_) << "\n";
   }
 
  private:
   const ResidualMeasure& measure_;
   double bound_;
+  bool trace_;
   double value_ = 0;
   Belos::StatusType status_ = Belos::Undefined;
 };
@@ -424,7 +432,7 @@ void PressureSolver<Dim>::Impl::runCG(const Teuchos::RCP<Operator>& precondition
   for (int attempt = 0; attempt < 3; ++attempt) {
     problem->setProblem();  // residual of the current iterate
     problem->setLSIndex(std::vector<int>{0});
-    auto bound = Teuchos::rcp(new ResidualBoundTest(measure, tolerance * b_norm));
+    auto bound = Teuchos::rcp(new ResidualBoundTest(measure, tolerance * b_norm, trace));
     auto budget = Teuchos::rcp(
         new Belos::StatusTestMaxIters<Scalar, MultiVector, Operator>(settings.maximum_iterations - iterations));
     auto test = Teuchos::rcp(new Combo(Combo::OR, budget, bound));
@@ -444,10 +452,6 @@ void PressureSolver<Dim>::Impl::runCG(const Teuchos::RCP<Operator>& precondition
     iterations += cg.getNumIters();
     report.relative_residual = residualNorm(b, x, measure) / b_norm;
     report.converged = report.relative_residual <= tolerance;
-    if (trace) {
-      std::cout << "  CG: " << cg.getNumIters() << " iterations, recurrence test ";
-      bound->print(std::cout, 0);
-    }
     if (report.converged || !reached || iterations >= settings.maximum_iterations) break;
   }
   report.iterations += iterations;
@@ -482,7 +486,7 @@ Teuchos::RCP<const Teuchos::ParameterList> PressureSolver<Dim>::validParameters(
          "CG iterations at most per preconditioner (a fresh one replacing a failed reused one gets its own)");
   p->set("preconditioner", std::string("muelu"),
          "muelu (smoothed aggregation, Chebyshev smoother), jacobi or none (the last two for comparison)");
-  p->set("verbosity", 0, "0 quiet; 1 one line per solve on rank 0; 2 also Belos iterations and MueLu setup");
+  p->set("verbosity", 0, "0 quiet; 1 one line per solve on rank 0; 2 also every CG iteration's residual and MueLu's setup");
   p->set("reuse interval", 1, "a full MueLu setup every N solves (1: every solve)");
   p->set("reuse mode", std::string("RP"),
          "between full setups: RP keeps aggregates, prolongators and restrictions and recomputes the coarse "

@@ -268,8 +268,8 @@ void defineIce(ParameterList& ice)
          positive(""));
   define(ice, "solver_tolerance", 0.0,
          "Relative residual (2-norm) of each linear pressure solve. 0: each solve stops once every cell's "
-         "residual is below 0.5 `outer_tolerance` V (doc/ice-pressure.md), or at 1e-10 of the largest entry of "
-         "the right-hand side if that comes first.",
+         "residual, weighed as the outer test weighs it, is below 0.5 `outer_tolerance` V (doc/ice-pressure.md), "
+         "or at 1e-10 of the largest weighted entry of the right-hand side if that comes first.",
          between(0, false, 1e-2, true));
   define(ice, "dt_growth", 1.2, "Largest ratio of successive time steps.", greaterThan(1));
   define(ice, "odd_even_filter", 0.0,

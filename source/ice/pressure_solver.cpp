@@ -9,7 +9,6 @@
 #include <BelosCGIter.hpp>
 #include <BelosLinearProblem.hpp>
 #include <BelosStatusTestCombo.hpp>
-#include <BelosStatusTestGenResNorm.hpp>
 #include <BelosStatusTestMaxIters.hpp>
 #include <BelosTpetraAdapter.hpp>
 #include <MueLu_CreateTpetraPreconditioner.hpp>

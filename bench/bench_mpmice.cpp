@@ -5,6 +5,7 @@
 //
 // usage: [mpiexec -n N] bench_mpmice [steps [dt]]     (defaults 200 steps of 2e-5 s)
 #include "coupled_support.hpp"
+#include "mpmice/run_state.hpp"
 
 #include <Tpetra_Core.hpp>
 
@@ -45,7 +46,13 @@ std::vector<std::string> phases()
 std::map<std::string, double> measure(const Scene& scene, int steps, double dt, double& outer_per_step,
                                       double& linear_per_step, const Teuchos::RCP<const Teuchos::Comm<int>>& comm)
 {
-  test::CoupledRun<2> run(scene, comm);
+  // The division the program takes: by cells, or with the cells that rigid bodies fill weighed
+  // less (divisionByOpenCells), from the initial state.
+  const Grid<2> grid(scene.domain);
+  const Decomposition division =
+      divisionByOpenCells(buildRunState(scene, grid, partitionPatches(grid, comm->getSize()), comm), 0.0)
+          .decomposition;
+  test::CoupledRun<2> run(scene, comm, division);
   const auto advance = [&] {
     run.last = run.stepper.step(run.state, dt);
     run.time += dt;

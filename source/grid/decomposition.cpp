@@ -181,13 +181,16 @@ double loadImbalance(const std::vector<double>& load)
 }
 
 template <int Dim>
-PatchWork patchWork(const Grid<Dim>& grid, const std::vector<long long>& particles, double particle_work)
+PatchWork patchWork(const Grid<Dim>& grid, const std::vector<long long>& particles, double particle_work,
+                    const std::vector<long long>& closed)
 {
   PatchWork work;
   work.cells.resize(grid.patchCount());
   work.particles.assign(grid.patchCount(), 0.0);
   for (int p = 0; p < grid.patchCount(); ++p) {
-    work.cells[p] = double(grid.patchCells(p).count());
+    const double shut = closed.empty() ? 0.0 : double(closed[p]);
+    // At least one cell's work, so that METIS's first constraint stays positive.
+    work.cells[p] = std::max(1.0, double(grid.patchCells(p).count()) - (1.0 - kClosedCellWork) * shut);
     if (!particles.empty()) work.particles[p] = particle_work * double(particles[p]);
   }
   return work;
@@ -209,7 +212,7 @@ template Decomposition partitionPatches<2>(const Grid<2>&, int, const std::vecto
 template Decomposition partitionPatches<3>(const Grid<3>&, int, const std::vector<double>&);
 template Decomposition partitionPatches<2>(const Grid<2>&, int, const PatchWork&);
 template Decomposition partitionPatches<3>(const Grid<3>&, int, const PatchWork&);
-template PatchWork patchWork(const Grid<2>&, const std::vector<long long>&, double);
-template PatchWork patchWork(const Grid<3>&, const std::vector<long long>&, double);
+template PatchWork patchWork(const Grid<2>&, const std::vector<long long>&, double, const std::vector<long long>&);
+template PatchWork patchWork(const Grid<3>&, const std::vector<long long>&, double, const std::vector<long long>&);
 
 }  // namespace cfdmpm

@@ -61,9 +61,17 @@ struct PatchWork {
   }
 };
 
-/// The work of the grid's patches with `particles` per patch (indexed by patch id; empty: none).
+/// The work of a cell that rigid bodies fill (IceSolver::closedCells), in units of an open cell's:
+/// the fluid phases skip it, but it keeps its row of the pressure matrix (CG, the preconditioner)
+/// and the passes over every cell (closure, checks, halos). Measured on the seed scene at 10 mm on
+/// 2 ranks (doc/scaling.md, "Weights").
+constexpr double kClosedCellWork = 0.5;
+
+/// The work of the grid's patches with `particles` per patch (indexed by patch id; empty: none)
+/// and `closed` cells per patch (empty: none), each closed cell weighing kClosedCellWork.
 template <int Dim>
-PatchWork patchWork(const Grid<Dim>& grid, const std::vector<long long>& particles, double particle_work);
+PatchWork patchWork(const Grid<Dim>& grid, const std::vector<long long>& particles, double particle_work,
+                    const std::vector<long long>& closed = {});
 
 /// Partitions the patches with both parts of the work balanced, each on its own (METIS with two
 /// constraints; with no particles, by cells). Where METIS finds no such division that gives every

@@ -360,6 +360,8 @@ LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, d
   const int materials = materials_;
   const unsigned held = options_.held_materials;
   const LocalOrdinal owned = layout_->ownedCells();
+  const auto closed = options_.closed_cells;
+  const bool any_closed = closed.extent(0) > 0;
 
   // Per cell (owned and ghost, so that every owned face has its donor) and material, the slab
   // geometry from the cell's 2 Dim face velocities, then:
@@ -376,6 +378,15 @@ LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, d
   Kokkos::parallel_reduce(
       "advection slabs", Kokkos::RangePolicy<ExecutionSpace>(0, cells),
       KOKKOS_LAMBDA(int c, LargestOutflow& best) {
+        if (any_closed && closed(c)) {
+          // Nothing leaves; update() skips the cell. Its slabs are zero (its faces' velocities are).
+          for (int m = 0; m < materials; ++m)
+            for (int f = 0; f < 2 * Dim; ++f) {
+              outflow_mass(c, f, m) = 0.0;
+              if (slab_densities) slab_density(c, f, m) = 0.0;
+            }
+          return;
+        }
         const auto local = stencil.local(c);
         for (int m = 0; m < materials; ++m) {
           // A held material: update() skips it and its slab densities keep their initial 0.
@@ -485,6 +496,8 @@ void Advector<Dim>::update(Field<Dim>& mass, const std::vector<Field<Dim>*>& mas
   auto M = mass.view();
   const int materials = materials_;
   const unsigned held = options_.held_materials;
+  const auto closed = options_.closed_cells;
+  const bool any_closed = closed.extent(0) > 0;
 
   // Each face's flux is one stored number, read by the donor (out) and by the receiver (in). Per
   // column, (M q)_new = M q - Σ_out F q_out + Σ_in F q_in, written as an increment of q so that zero
@@ -492,6 +505,7 @@ void Advector<Dim>::update(Field<Dim>& mass, const std::vector<Field<Dim>*>& mas
   // Cell c's entries are read and written by its own iteration only, so the update is in place.
   Kokkos::parallel_for(
       "advection update", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()), KOKKOS_LAMBDA(int c) {
+        if (any_closed && closed(c)) return;  // nothing entered or left
         LocalOrdinal neighbour[2 * Dim];
         for (int f = 0; f < 2 * Dim; ++f) neighbour[f] = neighbours(c, f);
         for (int m = 0; m < materials; ++m) {

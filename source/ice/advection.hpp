@@ -59,6 +59,12 @@ class Advector {
     /// for it, without computing their profiles (a third of the cell-material pairs of the seed
     /// scene are its bed and sand).
     unsigned held_materials = 0;
+    /// Per local cell (owned and ghost), 1 where nothing flows: every face of the cell has a zero
+    /// velocity for every material that moves (the coupled step's cells inside a rigid body,
+    /// IceSolver::closedCells). Such a cell keeps its mass and quantities and sends nothing, without
+    /// computing its profiles. Empty: every cell is open. The advector reads the view's current
+    /// contents at each call.
+    Kokkos::View<const unsigned char*, MemorySpace> closed_cells;
   };
 
   /// Work arrays for `materials` materials on the layout's cells are allocated here, once.

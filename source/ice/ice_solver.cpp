@@ -148,14 +148,17 @@ KOKKOS_INLINE_FUNCTION double rigidClosedShare(int materials, const MaterialRole
   return Kokkos::Experimental::fmin(1.0, closed);
 }
 
-// Calls f(std::integral_constant<int, N>()): N = 2 for two materials, so that the kernels' loops over
-// materials have constant bounds (and the exchange takes its two-material form), else N = 0 (the
-// count is read at run time).
+// Calls f(std::integral_constant<int, N>()): N = 2 for two materials (two fluids; the exchange then
+// takes its two-material form) and N = 4 for four (two fluids and two solids, as the seed scene's
+// water, air, sand and bed), so that the kernels' loops over materials have constant bounds, else
+// N = 0 (the count is read at run time).
 template <class F>
 void forMaterialCount(int materials, F&& f)
 {
   if (materials == 2)
     f(std::integral_constant<int, 2>());
+  else if (materials == 4)
+    f(std::integral_constant<int, 4>());
   else
     f(std::integral_constant<int, 0>());
 }
@@ -225,6 +228,7 @@ IceSolver<Dim>::IceSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>>
       solid_reference_pressure_(layout, Location::Cell, 1, "solid_reference_pressure"),
       solid_particle_volume_(layout, Location::Cell, solids.empty() ? 1 : materials_, "solid_particle_volume")
 {
+  closed_ = CellMask("closed cells", layout->overlapCells());  // zero: every cell open
   solid_reference_pressure_.fill(scene.initial.pressure);
   if (!solids.empty()) {
     fluid_outflow_share_ = typename Advector<Dim>::CapView("fluid outflow share", layout->overlapCells(), 2 * Dim);
@@ -249,6 +253,7 @@ IceSolver<Dim>::IceSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>>
                          "their heat exchange with the fluids would be missing");
       roles_.lagrangian[m] = 1;
       roles_.rigid[m] = solid->rigid ? 1 : 0;
+      any_rigid_ = any_rigid_ || solid->rigid;
       roles_.any_solid = true;
       bulk_modulus_[m] = solid->bulk_modulus;
       // The reference density and pressure are replaced per cell in the equilibration.
@@ -287,6 +292,7 @@ IceSolver<Dim>::IceSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>>
   typename Advector<Dim>::Options advection;
   for (int m = 0; m < materials_; ++m)
     if (roles_.lagrangian[m]) advection.held_materials |= 1u << m;  // solids move with their particles
+  advection.closed_cells = closed_;  // nothing flows into or out of them
   advector_ = std::make_unique<Advector<Dim>>(layout, materials_, advection);
 }
 
@@ -298,6 +304,57 @@ void IceSolver<Dim>::setSolidReferencePressure(const Field<Dim>& pressure)
 {
   Kokkos::deep_copy(solid_reference_pressure_.view(), pressure.view());
   solid_reference_pressure_.exchangeHalo();  // the momentum sources read it in the neighbours
+}
+
+// A cell that rigid bodies fill is a wall (closedCells). From the particles' volume fractions, which
+// the coupled step sets in owned and ghost cells before the equilibration phase. A deformable solid
+// in the cell (its boxes overlapping the body's: both shares are then scaled below 1 anyway) keeps it
+// open, so that the exchange and the pressure reach it.
+template <int Dim>
+void IceSolver<Dim>::markClosedCells(const CellState<Dim>& state)
+{
+  if (!any_rigid_) return;
+  const int n = materials_;
+  const auto roles = roles_;
+  const auto theta = state.volume_fraction.view();
+  const auto rho = state.density.view();
+  auto closed = closed_;
+  const LocalOrdinal owned = layout_->ownedCells();
+  long long local = 0;
+  Kokkos::parallel_reduce(
+      "ice::markClosedCells", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->overlapCells()),
+      KOKKOS_LAMBDA(const LocalOrdinal c, long long& count) {
+        double rigid = 0;
+        bool other_solid = false;
+        for (int m = 0; m < n; ++m) {
+          if (roles.rigid[m]) rigid += theta(c, m);
+          else if (roles.lagrangian[m] && rho(c, m) > 0) other_solid = true;
+        }
+        const bool shut = rigid >= 1.0 - kClosedGap && !other_solid;
+        closed(c) = shut ? 1 : 0;
+        if (shut && c < owned) ++count;
+      },
+      local);
+  Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_SUM, local, Teuchos::outArg(closed_count_));
+}
+
+template <int Dim>
+std::vector<long long> IceSolver<Dim>::closedCellsPerPatch() const
+{
+  const Grid<Dim>& grid = layout_->grid();
+  const int patches = grid.patchCount();
+  std::vector<long long> local(std::size_t(patches), 0), total(std::size_t(patches), 0);
+  const auto closed = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), closed_);
+  const auto ijk = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), layout_->cellIndex());
+  const Box first_patch = grid.patchCells(0);  // patches are full size except the last per direction
+  for (LocalOrdinal c = 0; c < layout_->ownedCells(); ++c) {
+    if (!closed(c)) continue;
+    std::array<long long, 3> patch{0, 0, 0};
+    for (int d = 0; d < Dim; ++d) patch[d] = ijk(c, d) / first_patch.extent(d);
+    ++local[std::size_t(grid.patchId(patch))];
+  }
+  Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_SUM, patches, local.data(), total.data());
+  return total;
 }
 
 // [3] Equilibration pressure: per cell, the pressure at which the materials' volumes fill it.
@@ -324,6 +381,7 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
   auto sum_kappa = mixture_compressibility_.view();
   const auto p_ref = solid_reference_pressure_.view();
   auto particle_volume = solid_particle_volume_.view();
+  const auto closed = closed_;
   const auto ijk = layout_->cellIndex();
   const long long nx = layout_->grid().cells()[0], ny = layout_->grid().cells()[1];
   Kokkos::View<long long, MemorySpace> first("first failed cell");
@@ -335,6 +393,7 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
     Kokkos::parallel_reduce(
         "ice::equilibrate", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
         KOKKOS_LAMBDA(const LocalOrdinal c, int& failed) {
+          if (closed(c)) return;  // a wall: its pressure and traces of fluid stay as they are
           const int nm = N > 0 ? N : n;
           ice::MaterialArray<double> mass_density{}, temperature{};
           for (int m = 0; m < nm; ++m) {
@@ -428,6 +487,7 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
   const auto K = pairCoefficients(settings_.exchange_coefficient, n, roles, true);
   const bool with_solids = roles_.any_solid;
   const auto particle_volume = solid_particle_volume_.view();
+  const auto closed = closed_;
   forMaterialCount(n, [&](auto count) {
     constexpr int N = decltype(count)::value;
     for (int d = 0; d < Dim; ++d) {
@@ -445,6 +505,22 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
             const LocalOrdinal l = neighbours(c, 2 * d);
             if (l < 0) {
               for (int m = 0; m < nm; ++m) uf(c, m) = 0.0, vf(c, m) = 0.0;
+              beta(c, 0) = 0.0;
+              return;
+            }
+            if (closed(c) || closed(l)) {
+              // A face of a cell that rigid bodies fill is closed to everything else (as below
+              // with open = 0, which it is to within kClosedGap): the bodies keep their own face
+              // velocity, nothing else crosses or takes a pressure correction.
+              for (int m = 0; m < nm; ++m) {
+                double velocity = 0;
+                if (roles.rigid[m]) {
+                  const double rl = rho(l, m), rr = rho(c, m);
+                  velocity = (rl * u(l, m * Dim + d) + rr * u(c, m * Dim + d)) / (rl + rr + kTiny);
+                }
+                uf(c, m) = velocity, vf(c, m) = 0.0;
+                if (with_solids && roles.lagrangian[m]) kinematic(c, m) = velocity;
+              }
               beta(c, 0) = 0.0;
               return;
             }
@@ -550,6 +626,7 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
   const auto neighbours = layout_->cellNeighbours();
   const int n = materials_;
   const auto roles = roles_;
+  const auto closed = closed_;
   auto leaves = fluid_outflow_share_;
   for (int d = 0; d < Dim; ++d) {
     auto out = fluid_face_fraction_.direction(d).view();
@@ -558,6 +635,12 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
         "ice::fluidFaceFractions", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->overlapCells()),
         KOKKOS_LAMBDA(const LocalOrdinal c) {
           const LocalOrdinal l = neighbours(c, 2 * d);
+          if (closed(c) || (l >= 0 && closed(l))) {  // a closed face (faceVelocities): nothing crosses
+            for (int m = 0; m < n; ++m) out(c, 2 * m) = out(c, 2 * m + 1) = 0.0;
+            if (l >= 0) leaves(l, 2 * d + 1) = 1.0;
+            leaves(c, 2 * d) = 1.0;
+            return;
+          }
           double fluid[2] = {0, 0}, solid[2] = {0, 0};
           for (int m = 0; m < n; ++m) {
             if (roles.lagrangian[m] || roles.rigid[m]) {
@@ -624,6 +707,7 @@ void IceSolver<Dim>::carriedFaceBeta(int outer_iteration)
   // make ~10 % of the face crossing the face form predicts (doc/mpmice.md), and a matrix without it
   // needs 4-6 outer iterations per step on the seed scene instead of 6-10.
   const bool solid_faces = !solid_volume_predictor_;
+  const auto closed = closed_;
   for (int d = 0; d < Dim; ++d) {
     const auto vf = face_specific_volume_.direction(d).view();
     const auto fluid = fluid_face_fraction_.direction(d).view();
@@ -633,7 +717,12 @@ void IceSolver<Dim>::carriedFaceBeta(int outer_iteration)
     Kokkos::parallel_for(
         "ice::carriedFaceBeta", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->overlapCells()),
         KOKKOS_LAMBDA(const LocalOrdinal c) {
-          if (neighbours(c, 2 * d) < 0) return;  // a wall, or a ghost's outer face: as faceVelocities left it
+          const LocalOrdinal l = neighbours(c, 2 * d);
+          if (l < 0) return;  // a wall, or a ghost's outer face: as faceVelocities left it
+          if (closed(c) || closed(l)) {  // closed (faceVelocities): no material takes a correction
+            beta(c, 0) = 0.0;
+            return;
+          }
           double b = 0;
           for (int m = 0; m < n; ++m) {
             if (roles.rigid[m]) continue;
@@ -689,6 +778,7 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
   const auto roles = faceRoles();
   // The solids' volume change from their particles (setSolidVolumePredictor): no face terms.
   const bool solid_faces = !solid_volume_predictor_;
+  const auto closed = closed_;
   for (int d = 0; d < Dim; ++d) {
     share[d] = solid_face_share_.direction(d).view();
     fluid[d] = fluid_face_fraction_.direction(d).view();
@@ -705,6 +795,18 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
         "ice::pressureRhs", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
         KOKKOS_LAMBDA(const LocalOrdinal c, double& worst) {
           const int nm = N > 0 ? N : n;
+          if (closed(c)) {
+            // A wall: no volume crosses its faces, its pressure stays. Its row of the matrix has
+            // no neighbour (β = 0 on its faces) and a zero right-hand side; whatever δp the solve
+            // leaves there moves no face (v_f = 0) and is not applied, and its weight leaves it
+            // out of the stopping tests.
+            if (kCorrect)
+              for (int d = 0; d < Dim; ++d)
+                for (int m = 0; m < nm; ++m) corrected[d](c, m) = uf[d](c, m);
+            rhs(c, 0) = 0.0;
+            outer_weight(c, 0) = 0.0;
+            return;
+          }
           if (kCorrect) {
             sum_dp(c, 0) += dp(c, 0);
             p(c, 0) = p_eq(c, 0) + sum_dp(c, 0);
@@ -840,12 +942,17 @@ void IceSolver<Dim>::momentumSourcePhase(CellState<Dim>& state, double dt)
   for (int f = 0; f < 2 * Dim; ++f) no_slip[f] = wall_no_slip_[f];
   // New velocities go to a second field so that the viscous stencil reads old values only.
   auto un = new_velocity_.view();
+  const auto is_closed = closed_;
   forMaterialCount(n, [&](auto count) {
     constexpr int N = decltype(count)::value;
     Kokkos::parallel_for(
         "ice::momentumSources", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
         KOKKOS_LAMBDA(const LocalOrdinal c) {
           const int nm = N > 0 ? N : n;
+          if (is_closed(c)) {  // a wall: no force acts on what it holds
+            for (int k = 0; k < nm * Dim; ++k) un(c, k) = u(c, k);
+            return;
+          }
           LocalOrdinal neighbour[2 * Dim];
           for (int f = 0; f < 2 * Dim; ++f) neighbour[f] = neighbours(c, f);
           ice::MaterialArray<double> r{}, t{};
@@ -907,7 +1014,7 @@ void IceSolver<Dim>::momentumSourcePhase(CellState<Dim>& state, double dt)
                 // The share of the face a rigid body closes is a wall (faceVelocities lets no
                 // fluid through it): the pressure of a cell the body fills, set by its trace of
                 // fluid and the body's stiffness, does not reach the fluid beside it.
-                const double closed = o < 0 ? 1.0 : rigidClosedShare(nm, roles, share[d], side == 0 ? c : o);
+                const double closed = o < 0 || is_closed(o) ? 1.0 : rigidClosedShare(nm, roles, share[d], side == 0 ? c : o);
                 if (closed >= 1.0) {
                   face_p[side] = wall;
                   extrapolate[side] = !(rho_c > 0);
@@ -984,6 +1091,7 @@ void IceSolver<Dim>::filterOddEven(const CellState<Dim>& state)
   const auto neighbours = layout_->cellNeighbours();
   const auto rho = state.density.view();
   const auto roles = roles_;
+  const auto closed = closed_;
   auto un = new_velocity_.view();
   auto increment = filter_increment_.view();
   auto laplacian = filter_laplacian_.view();
@@ -1027,7 +1135,7 @@ void IceSolver<Dim>::filterOddEven(const CellState<Dim>& state)
           for (int col = 0; col < columns; ++col) {
             const int m = col / Dim;
             const double rc = rho(c, m);
-            const bool filtered = !roles.lagrangian[m] && !roles.rigid[m] && rc > 0;
+            const bool filtered = !roles.lagrangian[m] && !roles.rigid[m] && rc > 0 && !closed(c);
             laplacian(c, col) = filtered ? weightedDifference(c, col, rc, un) / rc : 0.0;
           }
         });
@@ -1043,7 +1151,7 @@ void IceSolver<Dim>::filterOddEven(const CellState<Dim>& state)
           for (int col = 0; col < columns; ++col) {
             const int m = col / Dim;
             const double rc = rho(c, m);
-            if (roles.lagrangian[m] || roles.rigid[m] || !(rc > 0)) continue;
+            if (roles.lagrangian[m] || roles.rigid[m] || !(rc > 0) || closed(c)) continue;
             increment(c, col) -= kappa * weightedDifference(c, col, rc, laplacian) / rc;
           }
         });
@@ -1074,6 +1182,7 @@ void IceSolver<Dim>::exchangePhase(CellState<Dim>& state, double dt, IceStepRepo
   const auto ijk = layout_->cellIndex();
   const long long nx = layout_->grid().cells()[0], ny = layout_->grid().cells()[1];
   auto un = new_velocity_.view();
+  const auto closed = closed_;
   // Failures are rare: counted with atomics (Kokkos 3.4 has no reduction over two reducers).
   Kokkos::View<int, MemorySpace> bad("exchange failures");
   Kokkos::View<long long, MemorySpace> first("first failed cell");
@@ -1083,6 +1192,7 @@ void IceSolver<Dim>::exchangePhase(CellState<Dim>& state, double dt, IceStepRepo
     Kokkos::parallel_for(
         "ice::exchangeCC", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
         KOKKOS_LAMBDA(const LocalOrdinal c) {
+          if (closed(c)) return;  // a wall: its velocities stay
           const int nm = N > 0 ? N : n;
           ice::MaterialArray<double> r{}, t{}, s{}, weight{};  // weight: r, a rigid body's scaled up
           ice::MaterialArray<Kokkos::Array<double, Dim>> vel{};
@@ -1190,6 +1300,7 @@ template <int Dim>
 void IceSolver<Dim>::equilibrationPhase(CellState<Dim>& state, IceStepReport& report)
 {
   Teuchos::TimeMonitor phase(*timers_.at("equilibration"));
+  markClosedCells(state);
   Kokkos::deep_copy(delta_p_.view(), state.pressure.view());  // the previous step's pressure (δp is reset before use)
   report.equilibration_failures = equilibrate(state);
   report.first_failed_equilibration = first_failed_equilibration_;
@@ -1395,6 +1506,7 @@ bool IceSolver<Dim>::followCompressibility(const CellState<Dim>& state)
   const auto p_eq = equilibrium_pressure_.view();
   const auto T = state.temperature.view();
   const auto eos = eos_;
+  const auto closed = closed_;
   const auto slope = KOKKOS_LAMBDA(const LocalOrdinal c) {
     double sk = 0;
     for (int m = 0; m < n; ++m)
@@ -1405,6 +1517,7 @@ bool IceSolver<Dim>::followCompressibility(const CellState<Dim>& state)
   Kokkos::parallel_reduce(
       "ice::compressibilityFallen", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
       KOKKOS_LAMBDA(const LocalOrdinal c, int& fallen) {
+        if (closed(c)) return;  // its pressure does not change
         if (slope(c) < (1.0 - kCompressibilityChange) * sum_kappa(c, 0)) fallen = 1;
       },
       Kokkos::Max<int>(local));
@@ -1413,7 +1526,9 @@ bool IceSolver<Dim>::followCompressibility(const CellState<Dim>& state)
   if (global == 0) return false;
   Kokkos::parallel_for(
       "ice::followCompressibility", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
-      KOKKOS_LAMBDA(const LocalOrdinal c) { sum_kappa(c, 0) = slope(c); });
+      KOKKOS_LAMBDA(const LocalOrdinal c) {
+        if (!closed(c)) sum_kappa(c, 0) = slope(c);
+      });
   return true;
 }
 
@@ -1449,12 +1564,14 @@ void IceSolver<Dim>::advectionPhase(CellState<Dim>& state, double dt, IceStepRep
     const auto rho = state.density.view();
     const auto v = state.specific_volume.view();
     const auto cv = specific_heat_;
+    const auto closed = closed_;
     const int n = materials_;
     forMaterialCount(n, [&](auto count) {
       constexpr int N = decltype(count)::value;
       Kokkos::parallel_for(
           "ice::closeCells", Kokkos::RangePolicy<ExecutionSpace>(0, state.density.overlapCount()),
           KOKKOS_LAMBDA(const LocalOrdinal c) {
+            if (closed(c)) return;  // nothing entered or left it
             const int nm = N > 0 ? N : n;
             for (int m = 0; m < nm; ++m) theta(c, m) = rho(c, m) * v(c, m);
             const double mass = followMixtureVelocity<Dim>(

@@ -134,6 +134,25 @@ class IceSolver {
   void advectionPhase(CellState<Dim>& state, double dt, IceStepReport& report);
 
   const MaterialRoles& roles() const { return roles_; }
+
+  /// Per local cell (owned and ghost): 1 where rigid bodies fill the cell (their volume fraction
+  /// from the particles at least 1 − kClosedGap, no other solid in it), set at the start of each
+  /// step's equilibration phase. Such a cell is a wall for the fluids: every face it has is closed
+  /// to them, and the fluid phases leave it as it is (its traces of fluid, its pressure) instead of
+  /// computing what would change nothing there; a third of the seed scene's cells lie inside its bed.
+  using CellMask = Kokkos::View<unsigned char*, MemorySpace>;
+  const CellMask& closedCells() const { return closed_; }
+  /// The cells with 1 in closedCells over all ranks, at the last equilibration phase.
+  long long closedCellCount() const { return closed_count_; }
+  /// Fills closedCells from the state's volume fractions (owned and ghost cells; the rigid bodies'
+  /// from the particles). The equilibration phase calls it at every step; the coupled step also
+  /// after the initial state's equilibration, which takes every cell, so that each has a pressure
+  /// and compressibility before it is closed. Collective.
+  void markClosedCells(const CellState<Dim>& state);
+  /// The closed cells of every patch of the grid, summed over the ranks (collective): the work of
+  /// a patch for its decomposition (decomposition.hpp, patchWork).
+  std::vector<long long> closedCellsPerPatch() const;
+  static constexpr double kClosedGap = 1e-9;
   /// The pressure about which the solids' equation of state is taken in each cell (the pore pressure
   /// of still fluid there; default: initial_state.pressure everywhere). The coupled step sets it to
   /// the initial state's pressure, the hydrostatic pressure of the fluids that the solids displace.
@@ -216,6 +235,9 @@ class IceSolver {
   int materials_;
   MaterialRoles roles_;
   bool kinematic_solids_ = false;
+  bool any_rigid_ = false;  // some material is a rigid solid: cells may be closed
+  CellMask closed_;         // closedCells()
+  long long closed_count_ = 0;
   std::function<void(CellState<Dim>&, double)> solid_volume_predictor_;  // setSolidVolumePredictor
   /// The roles of the face phases (face velocities and exchange, the pressure equation): roles_,
   /// with every solid rigid there when the solids are kinematic (setKinematicSolids).

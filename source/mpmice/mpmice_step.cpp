@@ -65,6 +65,7 @@ MpmIceStep<Dim>::MpmIceStep(const Scene& scene, std::shared_ptr<const Layout<Dim
     const int failures = ice_->equilibrate(state);
     if (failures > 0)
       throw std::runtime_error("initial equilibration pressure failed in " + std::to_string(failures) + " cells");
+    ice_->markClosedCells(state);  // for the decomposition's weights; every step marks them again
   }
 }
 

@@ -2,6 +2,8 @@
 
 #include "mpmice/initial_state.hpp"
 
+#include "common/error.hpp"
+
 #include <map>
 
 namespace cfdmpm {
@@ -56,6 +58,33 @@ RunState<Dim> redistribute(const Scene& scene, RunState<Dim>& from, const Decomp
   return to;
 }
 
+template <int Dim>
+Division divisionByOpenCells(const RunState<Dim>& run, double gain)
+{
+  Division result;
+  result.decomposition = run.layout->decomposition();
+  const IceSolver<Dim>* fluids = run.step->fluids();
+  if (!fluids) return result;
+  const std::vector<long long> closed = fluids->closedCellsPerPatch();
+  for (long long n : closed) result.closed_cells += n;
+  if (result.closed_cells == 0 || result.decomposition.ranks < 2) return result;
+  const Grid<Dim>& grid = run.layout->grid();
+  const PatchWork work = patchWork(grid, {}, 0.0, closed);
+  result.imbalance_before = result.imbalance_after = loadImbalance(result.decomposition, work);
+  Decomposition balanced;
+  try {
+    balanced = closestNumbering(partitionPatches(grid, result.decomposition.ranks, work), result.decomposition,
+                                work.total());
+  } catch (const InputError&) {
+    return result;  // METIS left a rank without patches: keep the division by cells
+  }
+  const double imbalance = loadImbalance(balanced, work);
+  if (!(imbalance < result.imbalance_before - gain)) return result;
+  result.decomposition = balanced;
+  result.imbalance_after = imbalance;
+  return result;
+}
+
 template RunState<2> buildRunState(const Scene&, const Grid<2>&, const Decomposition&,
                                    const Teuchos::RCP<const Teuchos::Comm<int>>&);
 template RunState<3> buildRunState(const Scene&, const Grid<3>&, const Decomposition&,
@@ -64,5 +93,7 @@ template void adoptState(const CellValues<2>&, const mpm::MpmSolver<2>::Particle
 template void adoptState(const CellValues<3>&, const mpm::MpmSolver<3>::ParticleSnapshot&, int, RunState<3>&);
 template RunState<2> redistribute(const Scene&, RunState<2>&, const Decomposition&);
 template RunState<3> redistribute(const Scene&, RunState<3>&, const Decomposition&);
+template Division divisionByOpenCells(const RunState<2>&, double);
+template Division divisionByOpenCells(const RunState<3>&, double);
 
 }  // namespace cfdmpm

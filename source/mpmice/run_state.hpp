@@ -71,4 +71,22 @@ void adoptState(const CellValues<Dim>& cells, const typename mpm::MpmSolver<Dim>
 template <int Dim>
 RunState<Dim> redistribute(const Scene& scene, RunState<Dim>& from, const Decomposition& decomposition);
 
+/// What dividing the patches by the fluid phases' work found (divisionByOpenCells).
+struct Division {
+  Decomposition decomposition;
+  long long closed_cells = 0;   // cells that rigid bodies fill, over the grid
+  double imbalance_before = 0;  // loadImbalance of the run's own division, with those weights
+  double imbalance_after = 0;   // and of the one returned
+};
+
+/// The patches divided so that the fluid phases' work is balanced where rigid bodies fill cells:
+/// such a cell (IceSolver::closedCells) weighs kClosedCellWork of an open one, and a division by
+/// cell counts gave the rank that holds a bed far less to do (the seed scene's bed fills 60 % of
+/// the cells of the rank that holds its slope on 2 ranks, 6 % of the other's). `run` is freshly
+/// built (its closed cells marked from the initial state); returns its own decomposition where no
+/// cell is closed, on one rank, or where the new one is not better by more than `gain`.
+/// Collective; every rank gets the same answer.
+template <int Dim>
+Division divisionByOpenCells(const RunState<Dim>& run, double gain);
+
 }  // namespace cfdmpm

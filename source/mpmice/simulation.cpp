@@ -146,6 +146,7 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
   const bool restarting = !options.restart_checkpoint.empty();
   Decomposition decomposition;
   bool rebalance_first = false;
+  bool continues_division = false;  // a restart on the checkpoint's decomposition
   if (restarting) {
     const CheckpointHeader header = readCheckpointHeader(mpi, options.restart_checkpoint);
     if (header.ranks == ranks) {
@@ -156,6 +157,7 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
                          " patches");
       decomposition.ranks = ranks;
       decomposition.patch_owner = header.decomposition;
+      continues_division = true;
     } else {
       decomposition = partitionPatches(grid, ranks);
       rebalance_first = scene.domain.rebalance_interval > 0;
@@ -176,6 +178,24 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
   //    A rebalance replaces all three (layout, state, step) with new ones: `run_state` is the
   //    current set.
   RunState<Dim> run_state = buildRunState(scene, grid, decomposition, comm);
+  // Where rigid bodies fill cells the fluid phases skip them (IceSolver::closedCells), and a
+  // division by cell counts leaves the rank that holds a bed waiting for the others: the patches
+  // are divided again with those cells at kClosedCellWork (not on a restart that continues on the
+  // checkpoint's division, which was made so).
+  if (!continues_division) {
+    const Division division = divisionByOpenCells(run_state, kRebalanceGain);
+    if (!(division.decomposition.patch_owner == run_state.layout->decomposition().patch_owner)) {
+      run_state = buildRunState(scene, grid, division.decomposition, comm);
+      if (root) {
+        std::ostringstream line;
+        line.precision(3);
+        line << "  patches divided by their open cells (" << division.closed_cells
+             << " cells inside rigid bodies, each " << kClosedCellWork << " of an open one): imbalance "
+             << division.imbalance_before << " -> " << division.imbalance_after << "\n";
+        std::cout << line.str();
+      }
+    }
+  }
   CoupledStepReport step_report;
   const bool moves = run_state.step->fluidsMove() || run_state.step->hasParticles();
   const bool fluids_move = run_state.step->fluidsMove(), has_particles = run_state.step->hasParticles();
@@ -389,7 +409,9 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
     RebalanceReport result;
     std::vector<long long> particles;
     if (const mpm::MpmSolver<Dim>* solids = run_state.step->particles()) particles = solids->particlesPerPatch();
-    const PatchWork work = patchWork(grid, particles, particle_work);
+    std::vector<long long> closed;
+    if (const IceSolver<Dim>* fluids = run_state.step->fluids()) closed = fluids->closedCellsPerPatch();
+    const PatchWork work = patchWork(grid, particles, particle_work, closed);
     const Decomposition& current = run_state.layout->decomposition();
     result.imbalance_before = result.imbalance_after = loadImbalance(current, work);
     Decomposition balanced;

@@ -124,6 +124,13 @@ TEST(Decomposition, ImbalanceAndWork)
   EXPECT_EQ(work.particles, (std::vector<double>{5.0, 10.0}));
   EXPECT_EQ(work.total(), (std::vector<double>{261.0, 138.0}));
   EXPECT_EQ(patchWork(grid, {}, 0.5).particles, (std::vector<double>{0.0, 0.0}));
+  // Cells that rigid bodies fill weigh kClosedCellWork of an open one; a patch all closed still
+  // weighs at least one cell (METIS's first constraint must stay positive).
+  const PatchWork shut = patchWork(grid, {}, 0.5, {100, 128});
+  EXPECT_DOUBLE_EQ(shut.cells[0], 256.0 - (1.0 - kClosedCellWork) * 100);
+  EXPECT_DOUBLE_EQ(shut.cells[1], 128.0 - (1.0 - kClosedCellWork) * 128);
+  const Grid<2> tiny({0, 0, 0}, {1, 1, 0}, {2, 2, 1}, {1, 1, 1});
+  EXPECT_DOUBLE_EQ(patchWork(tiny, {}, 0.5, {1, 1, 1, 1}).cells[0], 1.0);
   // Each phase waits for its slowest rank: rank 0 with the most cells and rank 1 with the most
   // particles make a step of 256 + 10 against a balanced (384 + 15) / 2.
   Decomposition two;

@@ -99,9 +99,13 @@ inline LineFit fitLine(const std::vector<double>& t, const std::vector<double>& 
 template <int Dim>
 struct CoupledRun {
   CoupledRun(const Scene& s, const Teuchos::RCP<const Teuchos::Comm<int>>& comm)
+      : CoupledRun(s, comm, partitionPatches(Grid<Dim>(s.domain), comm->getSize()))
+  {
+  }
+  /// On a given division of the grid's patches.
+  CoupledRun(const Scene& s, const Teuchos::RCP<const Teuchos::Comm<int>>& comm, const Decomposition& division)
       : scene(s),
-        layout(std::make_shared<const Layout<Dim>>(Grid<Dim>(s.domain), partitionPatches(Grid<Dim>(s.domain), comm->getSize()),
-                                                   s.domain.ghost_width, comm)),
+        layout(std::make_shared<const Layout<Dim>>(Grid<Dim>(s.domain), division, s.domain.ghost_width, comm)),
         state(layout, int(s.materials.size())),
         stepper(((void)setInitialState(scene, densityFunctions(scene), state), s), layout, state)
   {

@@ -208,10 +208,31 @@ double loadImbalance(const Decomposition& decomposition, const PatchWork& work)
   return balanced > 0 ? slowest / balanced - 1.0 : 0.0;
 }
 
+template <int Dim>
+Redivision divideAgain(const Grid<Dim>& grid, const Decomposition& current, const PatchWork& work, double gain)
+{
+  Redivision result;
+  result.decomposition = current;
+  result.imbalance_before = result.imbalance_after = loadImbalance(current, work);
+  Decomposition balanced;
+  try {
+    balanced = closestNumbering(partitionPatches(grid, current.ranks, work), current, work.total());
+  } catch (const InputError&) {
+    return result;  // METIS left a rank without patches: stay
+  }
+  const double imbalance = loadImbalance(balanced, work);
+  if (!(imbalance < result.imbalance_before - gain)) return result;
+  result.decomposition = balanced;
+  result.imbalance_after = imbalance;
+  return result;
+}
+
 template Decomposition partitionPatches<2>(const Grid<2>&, int, const std::vector<double>&);
 template Decomposition partitionPatches<3>(const Grid<3>&, int, const std::vector<double>&);
 template Decomposition partitionPatches<2>(const Grid<2>&, int, const PatchWork&);
 template Decomposition partitionPatches<3>(const Grid<3>&, int, const PatchWork&);
+template Redivision divideAgain(const Grid<2>&, const Decomposition&, const PatchWork&, double);
+template Redivision divideAgain(const Grid<3>&, const Decomposition&, const PatchWork&, double);
 template PatchWork patchWork(const Grid<2>&, const std::vector<long long>&, double, const std::vector<long long>&);
 template PatchWork patchWork(const Grid<3>&, const std::vector<long long>&, double, const std::vector<long long>&);
 

@@ -83,4 +83,18 @@ Decomposition partitionPatches(const Grid<Dim>& grid, int ranks, const PatchWork
 /// work (each phase waits for its own slowest rank), over the balanced work per rank, minus one.
 double loadImbalance(const Decomposition& decomposition, const PatchWork& work);
 
+/// What dividing the patches again found (divideAgain).
+struct Redivision {
+  Decomposition decomposition;
+  double imbalance_before = 0;  // loadImbalance of the current division
+  double imbalance_after = 0;   // and of the one returned (the same where it is the current one)
+};
+
+/// The patches divided again by `work` (partitionPatches, renumbered by closestNumbering so that as
+/// much work as possible stays where `current` has it), where that lowers the estimated imbalance by
+/// more than `gain`; else `current`, as also where METIS leaves a rank without patches.
+/// Deterministic like partitionPatches.
+template <int Dim>
+Redivision divideAgain(const Grid<Dim>& grid, const Decomposition& current, const PatchWork& work, double gain);
+
 }  // namespace cfdmpm

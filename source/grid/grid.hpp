@@ -89,6 +89,14 @@ class Grid {
   std::array<long long, 3> patchIndex(int p) const { return unlinear(p, patches_); }
   int patchId(const std::array<long long, 3>& pijk) const { return int(linear(pijk, patches_)); }
 
+  /// The patch that holds the cell with global index ijk.
+  int patchOfCell(const std::array<long long, 3>& ijk) const
+  {
+    std::array<long long, 3> pijk{0, 0, 0};
+    for (int d = 0; d < 3; ++d) pijk[d] = ijk[d] / patch_cells_[d];
+    return patchId(pijk);
+  }
+
   /// The cells of patch p; the last patch in a direction may be smaller.
   Box patchCells(int p) const
   {

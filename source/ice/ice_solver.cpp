@@ -148,6 +148,14 @@ KOKKOS_INLINE_FUNCTION double rigidClosedShare(int materials, const MaterialRole
   return Kokkos::Experimental::fmin(1.0, closed);
 }
 
+// Whether the face between cells c and l (l < 0: none) is shut because either cell is closed
+// (IceSolver::closedCells): nothing but the rigid bodies moves across it.
+template <class Mask>
+KOKKOS_INLINE_FUNCTION bool shutFace(const Mask& closed, LocalOrdinal c, LocalOrdinal l)
+{
+  return closed(c) || (l >= 0 && closed(l));
+}
+
 // Calls f(std::integral_constant<int, N>()): N = 2 for two materials (two fluids; the exchange then
 // takes its two-material form) and N = 4 for four (two fluids and two solids, as the seed scene's
 // water, air, sand and bed), so that the kernels' loops over materials have constant bounds, else
@@ -346,12 +354,11 @@ std::vector<long long> IceSolver<Dim>::closedCellsPerPatch() const
   std::vector<long long> local(std::size_t(patches), 0), total(std::size_t(patches), 0);
   const auto closed = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), closed_);
   const auto ijk = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), layout_->cellIndex());
-  const Box first_patch = grid.patchCells(0);  // patches are full size except the last per direction
   for (LocalOrdinal c = 0; c < layout_->ownedCells(); ++c) {
     if (!closed(c)) continue;
-    std::array<long long, 3> patch{0, 0, 0};
-    for (int d = 0; d < Dim; ++d) patch[d] = ijk(c, d) / first_patch.extent(d);
-    ++local[std::size_t(grid.patchId(patch))];
+    std::array<long long, 3> cell{0, 0, 0};
+    for (int d = 0; d < Dim; ++d) cell[d] = ijk(c, d);
+    ++local[std::size_t(grid.patchOfCell(cell))];
   }
   Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_SUM, patches, local.data(), total.data());
   return total;
@@ -508,7 +515,7 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
               beta(c, 0) = 0.0;
               return;
             }
-            if (closed(c) || closed(l)) {
+            if (shutFace(closed, c, l)) {
               // A face of a cell that rigid bodies fill is closed to everything else (as below
               // with open = 0, which it is to within kClosedGap): the bodies keep their own face
               // velocity, nothing else crosses or takes a pressure correction.
@@ -635,7 +642,7 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
         "ice::fluidFaceFractions", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->overlapCells()),
         KOKKOS_LAMBDA(const LocalOrdinal c) {
           const LocalOrdinal l = neighbours(c, 2 * d);
-          if (closed(c) || (l >= 0 && closed(l))) {  // a closed face (faceVelocities): nothing crosses
+          if (shutFace(closed, c, l)) {  // (faceVelocities): nothing crosses
             for (int m = 0; m < n; ++m) out(c, 2 * m) = out(c, 2 * m + 1) = 0.0;
             if (l >= 0) leaves(l, 2 * d + 1) = 1.0;
             leaves(c, 2 * d) = 1.0;
@@ -719,7 +726,7 @@ void IceSolver<Dim>::carriedFaceBeta(int outer_iteration)
         KOKKOS_LAMBDA(const LocalOrdinal c) {
           const LocalOrdinal l = neighbours(c, 2 * d);
           if (l < 0) return;  // a wall, or a ghost's outer face: as faceVelocities left it
-          if (closed(c) || closed(l)) {  // closed (faceVelocities): no material takes a correction
+          if (shutFace(closed, c, l)) {  // (faceVelocities): no material takes a correction
             beta(c, 0) = 0.0;
             return;
           }

@@ -2,8 +2,6 @@
 
 #include "mpmice/initial_state.hpp"
 
-#include "common/error.hpp"
-
 #include <map>
 
 namespace cfdmpm {
@@ -69,19 +67,10 @@ Division divisionByOpenCells(const RunState<Dim>& run, double gain)
   for (long long n : closed) result.closed_cells += n;
   if (result.closed_cells == 0 || result.decomposition.ranks < 2) return result;
   const Grid<Dim>& grid = run.layout->grid();
-  const PatchWork work = patchWork(grid, {}, 0.0, closed);
-  result.imbalance_before = result.imbalance_after = loadImbalance(result.decomposition, work);
-  Decomposition balanced;
-  try {
-    balanced = closestNumbering(partitionPatches(grid, result.decomposition.ranks, work), result.decomposition,
-                                work.total());
-  } catch (const InputError&) {
-    return result;  // METIS left a rank without patches: keep the division by cells
-  }
-  const double imbalance = loadImbalance(balanced, work);
-  if (!(imbalance < result.imbalance_before - gain)) return result;
-  result.decomposition = balanced;
-  result.imbalance_after = imbalance;
+  const Redivision again = divideAgain(grid, result.decomposition, patchWork(grid, {}, 0.0, closed), gain);
+  result.decomposition = again.decomposition;
+  result.imbalance_before = again.imbalance_before;
+  result.imbalance_after = again.imbalance_after;
   return result;
 }
 

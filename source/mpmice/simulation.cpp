@@ -411,19 +411,14 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
     if (const mpm::MpmSolver<Dim>* solids = run_state.step->particles()) particles = solids->particlesPerPatch();
     std::vector<long long> closed;
     if (const IceSolver<Dim>* fluids = run_state.step->fluids()) closed = fluids->closedCellsPerPatch();
-    const PatchWork work = patchWork(grid, particles, particle_work, closed);
     const Decomposition& current = run_state.layout->decomposition();
-    result.imbalance_before = result.imbalance_after = loadImbalance(current, work);
-    Decomposition balanced;
-    try {
-      balanced = closestNumbering(partitionPatches(grid, ranks, work), current, work.total());
-    } catch (const InputError&) {
-      return result;  // METIS left a rank without patches: stay
-    }
-    const double imbalance = loadImbalance(balanced, work);
-    if (!(imbalance < result.imbalance_before - kRebalanceGain)) return result;
+    const Redivision division =
+        divideAgain(grid, current, patchWork(grid, particles, particle_work, closed), kRebalanceGain);
+    result.imbalance_before = division.imbalance_before;
+    result.imbalance_after = division.imbalance_after;
+    const Decomposition& balanced = division.decomposition;
     for (int p = 0; p < grid.patchCount(); ++p) result.patches_moved += balanced.patch_owner[p] != current.patch_owner[p];
-    result.imbalance_after = imbalance;
+    if (result.patches_moved == 0) return result;
     run_state = redistribute(scene, run_state, balanced);
     output.moveTo(*run_state.layout);
     if (checkpoints)

@@ -157,3 +157,20 @@ TEST(Decomposition, CellsAndParticlesAreBalancedEachOnItsOwn)
     EXPECT_LT(loadImbalance(both, work), loadImbalance(total, work)) << ranks << " ranks";
   }
 }
+
+TEST(Decomposition, EveryCellIsInItsPatch)
+{
+  // Patches of 16 x 16 and 5 x 7 x 3, the last in each direction smaller.
+  const Grid<2> plane({0, 0, 0}, {1, 1, 0}, {24, 16, 1}, {16, 16, 1});
+  const Grid<3> box({0, 0, 0}, {1, 1, 1}, {11, 9, 4}, {5, 7, 3});
+  const auto check = [](const auto& grid) {
+    for (int p = 0; p < grid.patchCount(); ++p) {
+      const Box cells = grid.patchCells(p);
+      for (long long k = cells.lower[2]; k < cells.upper[2]; ++k)
+        for (long long j = cells.lower[1]; j < cells.upper[1]; ++j)
+          for (long long i = cells.lower[0]; i < cells.upper[0]; ++i) EXPECT_EQ(grid.patchOfCell({i, j, k}), p);
+    }
+  };
+  check(plane);
+  check(box);
+}

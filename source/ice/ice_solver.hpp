@@ -153,6 +153,14 @@ class IceSolver {
   /// a patch for its decomposition (decomposition.hpp, patchWork).
   std::vector<long long> closedCellsPerPatch() const;
   static constexpr double kClosedGap = 1e-9;
+  /// The cells that have no row in the pressure matrix (PressureSolver::excludeCells), a subset of
+  /// the closed cells: see updatePressureRows().
+  const CellMask& cellsWithoutPressureRow() const { return without_row_; }
+  /// Rows of the pressure matrix over all ranks.
+  long long pressureRows() const { return pressure_solver_->rows(); }
+  /// The pressure matrix is built again with the closed cells whose face neighbours are all closed
+  /// (or walls) left out once this share of the grid's cells are such cells and still have a row.
+  static constexpr double kPressureRowsGain = 0.02;
   /// The pressure about which the solids' equation of state is taken in each cell (the pore pressure
   /// of still fluid there; default: initial_state.pressure everywhere). The coupled step sets it to
   /// the initial state's pressure, the hydrostatic pressure of the fluids that the solids displace.
@@ -222,10 +230,12 @@ class IceSolver {
  private:
   void faceVelocities(const CellState<Dim>& state, double dt);
   double pressureRightHandSide(CellState<Dim>& state, double dt, bool after_solve);
+  void applyPressureCorrection(CellState<Dim>& state, double dt);
   // Σ_m θ_m κ_m s'(κ_m Σδp) into mixture_compressibility_ where that is more than
   // kCompressibilityChange below it somewhere; returns whether it wrote (then reassemble).
   bool followCompressibility(const CellState<Dim>& state);
   void secantSlopeWhereBoiling(const CellState<Dim>& state);
+  void updatePressureRows();
   void fluidFaceFractions(const CellState<Dim>& state, double dt);
   void energy(CellState<Dim>& state, const Field<Dim>& old_specific_volume, double dt);
 
@@ -237,6 +247,7 @@ class IceSolver {
   bool kinematic_solids_ = false;
   bool any_rigid_ = false;  // some material is a rigid solid: cells may be closed
   CellMask closed_;         // closedCells()
+  CellMask without_row_;    // cellsWithoutPressureRow()
   long long closed_count_ = 0;
   std::function<void(CellState<Dim>&, double)> solid_volume_predictor_;  // setSolidVolumePredictor
   /// The roles of the face phases (face velocities and exchange, the pressure equation): roles_,

@@ -228,12 +228,26 @@ struct PressureSolver<Dim>::Impl {
   Settings settings;
 
   Teuchos::RCP<CrsMatrix> matrix;
-  // (owned cell, slot) -> position of that entry in the local CRS values array; -1 across a wall.
-  // assemble() writes the values there directly: the graph and its maps never change.
+  // (row, slot) -> position of that entry in the local CRS values array; kNoEntry across a wall or
+  // towards an excluded cell. assemble() writes the values there directly: the graph and its maps
+  // change only with the excluded cells.
   Kokkos::View<std::size_t**, MemorySpace> stencil_offsets;
   static constexpr std::size_t kNoEntry = ~std::size_t(0);
 
-  // Work vectors of solve(), allocated once (a residual, the caller's guess, a weighted residual).
+  // The excluded cells the graph was built for (a copy of excludeCells()'s mask; empty: none).
+  CellMask excluded;
+  // With excluded cells: row k of the matrix is owned cell row_cell(k), and the caller's fields are
+  // gathered into (and scattered from) vectors over the rows. Without, the rows are the owned cells
+  // in the layout's map and the fields' owned parts are used as they are.
+  bool every_cell_a_row = true;
+  Kokkos::View<LocalOrdinal*, MemorySpace> row_cell;
+  long long global_rows = 0;
+  Teuchos::RCP<MultiVector> rows_b, rows_x, rows_weight, rows_y;
+  // The rows' cell centres (Dim columns), for MueLu's repartitioning of coarse levels.
+  Teuchos::RCP<MultiVector> coordinates;
+
+  // Work vectors of solve(), allocated once per graph (a residual, the caller's guess, a weighted
+  // residual).
   Teuchos::RCP<MultiVector> residual, guess, weighted;
 
   // Cumulative wall time of the parts of the solve, for profiling (bench/bench_ice).
@@ -258,6 +272,11 @@ struct PressureSolver<Dim>::Impl {
   std::array<bool, PressureSolver<Dim>::kSolveKinds> reference_due{};
 
   void buildGraph();
+  LocalOrdinal localRows() const { return LocalOrdinal(row_cell.extent(0)); }
+  /// rows(k) = field(row_cell(k)) over the rows; field: an owned part of a 1-column field.
+  void gather(const MultiVector& field, MultiVector& rows) const;
+  /// field(row_cell(k)) = rows(k), and 0 in the excluded owned cells.
+  void scatter(const MultiVector& rows, MultiVector& field) const;
   Teuchos::ParameterList mueluParameters() const;
   Teuchos::RCP<Operator> preparePreconditioner(PressureSolveReport& report);
   double residualNorm(const MultiVector& b, const MultiVector& x, const ResidualMeasure& measure) const;
@@ -273,54 +292,149 @@ void PressureSolver<Dim>::Impl::buildGraph()
   const LocalOrdinal owned = lay.ownedCells();
   const Map& overlap = *lay.overlapCellMap();
   const auto neighbours = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), lay.cellNeighbours());
+  const auto excluded_host = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), excluded);
+  const bool any_excluded_here = excluded.extent(0) > 0;
 
-  // Global ids of each row's stencil (the cell first, then its face neighbours inside the domain).
-  std::vector<GlobalOrdinal> stencil_gids(std::size_t(owned) * kStencil, -1);
-  std::vector<std::size_t> entries(owned, 0);
-  for (LocalOrdinal c = 0; c < owned; ++c) {
-    stencil_gids[c * kStencil] = overlap.getGlobalElement(c);
-    entries[c] = 1;
+  // The rows: the owned cells that are not excluded, in the layout's order.
+  std::vector<LocalOrdinal> cells;
+  cells.reserve(owned);
+  for (LocalOrdinal c = 0; c < owned; ++c)
+    if (!any_excluded_here || !excluded_host(c)) cells.push_back(c);
+  const long long local_rows = static_cast<long long>(cells.size());
+  long long excluded_cells = owned - local_rows, excluded_total = 0;
+  Teuchos::reduceAll(*lay.comm(), Teuchos::REDUCE_SUM, excluded_cells, Teuchos::outArg(excluded_total));
+  every_cell_a_row = excluded_total == 0;
+  Teuchos::reduceAll(*lay.comm(), Teuchos::REDUCE_SUM, local_rows, Teuchos::outArg(global_rows));
+
+  // Each overlap cell's global row id (-1: no row). Without excluded cells the rows are the layout's
+  // owned cells with their global ids; with them, rank r numbers its rows after those of ranks < r,
+  // and the ghosts learn their owners' numbers by a halo exchange (so that both sides of a face
+  // between ranks agree on whether it couples two rows).
+  std::vector<GlobalOrdinal> row_id(lay.overlapCells(), -1);
+  Teuchos::RCP<const Map> rows;
+  if (every_cell_a_row) {
+    rows = lay.ownedCellMap();
+    for (LocalOrdinal c = 0; c < lay.overlapCells(); ++c) row_id[c] = overlap.getGlobalElement(c);
+  } else {
+    long long first = 0;
+    Teuchos::scan(*lay.comm(), Teuchos::REDUCE_SUM, local_rows, Teuchos::outArg(first));
+    first -= local_rows;
+    rows = Teuchos::rcp(new Map(Tpetra::global_size_t(global_rows), std::size_t(local_rows), GlobalOrdinal(0), lay.comm()));
+    Field<Dim> ids(layout, Location::Cell, 1, "pressure row ids");
+    ids.fill(-1.0);
+    {
+      auto id = ids.view();
+      const auto id_host = Kokkos::create_mirror_view(id);
+      Kokkos::deep_copy(id_host, id);
+      for (std::size_t k = 0; k < cells.size(); ++k) id_host(cells[k], 0) = double(first + static_cast<long long>(k));
+      Kokkos::deep_copy(id, id_host);
+    }
+    ids.exchangeHalo();
+    const auto id_host = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), ids.view());
+    for (LocalOrdinal c = 0; c < lay.overlapCells(); ++c) row_id[c] = GlobalOrdinal(id_host(c, 0));
+  }
+  row_cell = Kokkos::View<LocalOrdinal*, MemorySpace>("pressure row cells", cells.size());
+  {
+    const auto host = Kokkos::create_mirror_view(row_cell);
+    for (std::size_t k = 0; k < cells.size(); ++k) host(k) = cells[k];
+    Kokkos::deep_copy(row_cell, host);
+  }
+
+  // Global ids of each row's stencil (the cell first, then its face neighbours that have rows).
+  const LocalOrdinal n_rows = LocalOrdinal(cells.size());
+  std::vector<GlobalOrdinal> stencil_gids(std::size_t(n_rows) * kStencil, -1);
+  std::vector<std::size_t> entries(n_rows, 0);
+  for (LocalOrdinal k = 0; k < n_rows; ++k) {
+    const LocalOrdinal c = cells[k];
+    stencil_gids[k * kStencil] = row_id[c];
+    entries[k] = 1;
     for (int f = 0; f < 2 * Dim; ++f) {
       const LocalOrdinal n = neighbours(c, f);
       if (n == Layout<Dim>::kOutsideDomain) continue;  // wall: no coupling
       if (n < 0) throw std::logic_error("PressureSolver: face neighbour of an owned cell is not local");
-      stencil_gids[c * kStencil + 1 + f] = overlap.getGlobalElement(n);
-      ++entries[c];
+      if (row_id[n] < 0) continue;  // an excluded cell: a wall
+      stencil_gids[k * kStencil + 1 + f] = row_id[n];
+      ++entries[k];
     }
   }
 
-  // Tpetra builds the column map from the global ids: owned cells plus the face-neighbour ghosts
-  // only, so the matrix-vector product imports no more than the stencil needs.
-  const Teuchos::RCP<const Map>& rows = lay.ownedCellMap();
+  // Tpetra builds the column map from the global ids: the rows plus the face-neighbour ghosts only,
+  // so the matrix-vector product imports no more than the stencil needs.
   auto graph = Teuchos::rcp(new Graph(rows, Teuchos::ArrayView<const std::size_t>(entries.data(), entries.size())));
-  for (LocalOrdinal c = 0; c < owned; ++c) {
+  for (LocalOrdinal k = 0; k < n_rows; ++k) {
     GlobalOrdinal columns[kStencil];
     int n = 0;
     for (int s = 0; s < kStencil; ++s)
-      if (stencil_gids[c * kStencil + s] >= 0) columns[n++] = stencil_gids[c * kStencil + s];
-    graph->insertGlobalIndices(stencil_gids[c * kStencil], Teuchos::ArrayView<const GlobalOrdinal>(columns, n));
+      if (stencil_gids[k * kStencil + s] >= 0) columns[n++] = stencil_gids[k * kStencil + s];
+    graph->insertGlobalIndices(stencil_gids[k * kStencil], Teuchos::ArrayView<const GlobalOrdinal>(columns, n));
   }
   graph->fillComplete(rows, rows);
 
   // Where each stencil entry sits in the local CRS arrays (the graph sorts a row's columns).
   const Map& column_map = *graph->getColMap();
   const auto local_graph = graph->getLocalGraphHost();
-  stencil_offsets = Kokkos::View<std::size_t**, MemorySpace>("pressure stencil offsets", owned, kStencil);
+  stencil_offsets = Kokkos::View<std::size_t**, MemorySpace>("pressure stencil offsets", n_rows, kStencil);
   const auto offsets_host = Kokkos::create_mirror_view(stencil_offsets);
-  for (LocalOrdinal c = 0; c < owned; ++c)
+  for (LocalOrdinal k = 0; k < n_rows; ++k)
     for (int s = 0; s < kStencil; ++s) {
-      const GlobalOrdinal gid = stencil_gids[c * kStencil + s];
-      offsets_host(c, s) = kNoEntry;
+      const GlobalOrdinal gid = stencil_gids[k * kStencil + s];
+      offsets_host(k, s) = kNoEntry;
       if (gid < 0) continue;
       const LocalOrdinal column = column_map.getLocalElement(gid);
-      for (auto k = local_graph.row_map(c); k < local_graph.row_map(c + 1); ++k)
-        if (local_graph.entries(k) == column) offsets_host(c, s) = k;
-      if (offsets_host(c, s) == kNoEntry) throw std::logic_error("PressureSolver: stencil entry missing from the graph");
+      for (auto e = local_graph.row_map(k); e < local_graph.row_map(k + 1); ++e)
+        if (local_graph.entries(e) == column) offsets_host(k, s) = e;
+      if (offsets_host(k, s) == kNoEntry) throw std::logic_error("PressureSolver: stencil entry missing from the graph");
     }
   Kokkos::deep_copy(stencil_offsets, offsets_host);
 
   matrix = Teuchos::rcp(new CrsMatrix(graph));
   matrix->fillComplete(rows, rows);  // all zeros until the first assemble()
+
+  // A new graph: the old preconditioner, work vectors and values do not fit it.
+  muelu = Teuchos::null;
+  jacobi = Teuchos::null;
+  residual = guess = weighted = Teuchos::null;
+  rows_b = rows_x = rows_weight = rows_y = Teuchos::null;
+  if (!every_cell_a_row) {
+    rows_b = Teuchos::rcp(new MultiVector(rows, 1));
+    rows_x = Teuchos::rcp(new MultiVector(rows, 1));
+    rows_weight = Teuchos::rcp(new MultiVector(rows, 1));
+    rows_y = Teuchos::rcp(new MultiVector(rows, 1));
+  }
+  coordinates = Teuchos::rcp(new MultiVector(rows, Dim));
+  {
+    const auto ijk = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), lay.cellIndex());
+    const auto x = coordinates->getLocalViewHost(Tpetra::Access::OverwriteAll);
+    for (LocalOrdinal k = 0; k < n_rows; ++k)
+      for (int d = 0; d < Dim; ++d) x(k, d) = lay.grid().cellCentre(d, ijk(cells[k], d));
+  }
+  assembled = false;
+  values_changed = true;
+  solves_since_setup = 0;
+  reference_due.fill(true);
+}
+
+template <int Dim>
+void PressureSolver<Dim>::Impl::gather(const MultiVector& field, MultiVector& rows) const
+{
+  const auto from = field.getLocalViewDevice(Tpetra::Access::ReadOnly);
+  const auto to = rows.getLocalViewDevice(Tpetra::Access::OverwriteAll);
+  const auto cell = row_cell;
+  Kokkos::parallel_for(
+      "pressure solver: gather", Kokkos::RangePolicy<ExecutionSpace>(0, localRows()),
+      KOKKOS_LAMBDA(const LocalOrdinal k) { to(k, 0) = from(cell(k), 0); });
+}
+
+template <int Dim>
+void PressureSolver<Dim>::Impl::scatter(const MultiVector& rows, MultiVector& field) const
+{
+  field.putScalar(0.0);  // the excluded cells
+  const auto from = rows.getLocalViewDevice(Tpetra::Access::ReadOnly);
+  const auto to = field.getLocalViewDevice(Tpetra::Access::ReadWrite);
+  const auto cell = row_cell;
+  Kokkos::parallel_for(
+      "pressure solver: scatter", Kokkos::RangePolicy<ExecutionSpace>(0, localRows()),
+      KOKKOS_LAMBDA(const LocalOrdinal k) { to(cell(k), 0) = from(k, 0); });
 }
 
 template <int Dim>
@@ -332,8 +446,29 @@ Teuchos::ParameterList PressureSolver<Dim>::Impl::mueluParameters() const
   p.set("multigrid algorithm", std::string("sa"));
   p.set("smoother: type", std::string("CHEBYSHEV"));
   // MueLu's default coarse solver (Amesos2 KLU2) diverges on more than one rank with Debian's
-  // Trilinos 13.2 (the coarse matrix stays distributed); ILUT on the coarse level works.
-  if (layout->comm()->getSize() > 1) p.set("coarse: type", std::string("ILUT"));
+  // Trilinos 13.2 while the coarse matrix stays distributed, and ILUT there (each rank's part alone)
+  // doubles the CG iterations against one rank (seed scene, 10 mm, 0.15 s: 29 against 15 per step).
+  // So from the first coarse level on, a level with fewer than 4000 rows per rank is moved onto
+  // fewer ranks (Zoltan2's partition of the rows' centres, given in "user data"); the coarsest
+  // level (at most MueLu's "coarse: max size", 2000 rows) lands on one rank, where KLU2 solves it
+  // exactly: 14.6 CG iterations per step on 2 ranks, as on one. A Trilinos without Zoltan2 (the
+  // threaded build's, utilities/build-trilinos-openmp.sh) keeps ILUT on the coarse level.
+  // A matrix of at most "coarse: max size" rows is its own coarsest level, which stays distributed
+  // (MueLu repartitions from level 1): ILUT there too.
+  const Teuchos::ParameterList& user = settings_list.sublist("muelu");
+  const int coarse_max = user.isType<int>("coarse: max size") ? user.get<int>("coarse: max size") : 2000;
+  if (layout->comm()->getSize() > 1 && global_rows <= coarse_max) {
+    p.set("coarse: type", std::string("ILUT"));
+  } else if (layout->comm()->getSize() > 1) {
+#ifdef HAVE_MUELU_ZOLTAN2
+    p.set("repartition: enable", true);
+    p.set("repartition: partitioner", std::string("zoltan2"));
+    p.set("repartition: start level", 1);
+    p.set("repartition: min rows per proc", 4000);
+#else
+    p.set("coarse: type", std::string("ILUT"));
+#endif
+  }
   if (settings.reuse_interval > 1 && settings.reuse_mode != ReuseMode::Frozen) {
     const char* type = settings.reuse_mode == ReuseMode::KeepRAP  ? "RAP"
                        : settings.reuse_mode == ReuseMode::KeepRP ? "RP"
@@ -382,6 +517,7 @@ Teuchos::RCP<Operator> PressureSolver<Dim>::Impl::preparePreconditioner(Pressure
   if (rebuild) {
     muelu = Teuchos::null;  // free the old hierarchy before building the new one
     Teuchos::ParameterList parameters = mueluParameters();
+    parameters.sublist("user data").set("Coordinates", coordinates);
     muelu = MueLu::CreateTpetraPreconditioner(Teuchos::RCP<Operator>(matrix), parameters);
     solves_since_setup = 0;
     rebuild_requested = false;
@@ -550,30 +686,35 @@ void PressureSolver<Dim>::assemble(const Field<Dim>& mixture_compressibility, Fa
   // The matrix's own values array (Serial: host memory; the graph is fixed, so no fill is resumed).
   const auto values = m.matrix->getLocalMatrixDevice().values;
   const auto offsets = m.stencil_offsets;
-  const LocalOrdinal owned = lay.ownedCells();
+  const auto row_cell = m.row_cell;
+  const LocalOrdinal rows = m.localRows();
 
-  // The first owned cell with a bad coefficient (owned when there is none).
-  LocalOrdinal first_bad = owned;
+  // The first row with a bad coefficient (rows when there is none).
+  LocalOrdinal first_bad_row = rows;
   Kokkos::parallel_reduce(
-      "pressure matrix values", Kokkos::RangePolicy<ExecutionSpace>(0, owned),
-      KOKKOS_LAMBDA(const LocalOrdinal c, LocalOrdinal& bad) {
+      "pressure matrix values", Kokkos::RangePolicy<ExecutionSpace>(0, rows),
+      KOKKOS_LAMBDA(const LocalOrdinal k, LocalOrdinal& bad) {
+        const LocalOrdinal c = row_cell(k);
         const double weight[3] = {wx, wy, wz};
         double diagonal = volume * kappa(c, 0);
         bool ok = kappa(c, 0) > 0 && kappa(c, 0) < INFINITY;
         for (int f = 0; f < 2 * Dim; ++f) {
+          if (offsets(k, 1 + f) == Impl::kNoEntry) continue;  // wall: zero normal gradient, no flux, no entry
           const LocalOrdinal n = neighbours(c, f);
-          if (n < 0) continue;  // wall: zero normal gradient, no flux, no entry
           const int d = f / 2;
           const double b = beta(d, f % 2 == 0 ? c : n);  // lower face of c, or of the upper neighbour
           ok = ok && b >= 0 && b < INFINITY;
           const double a = weight[d] * b;
-          values(offsets(c, 1 + f)) = -a;
+          values(offsets(k, 1 + f)) = -a;
           diagonal += a;
         }
-        values(offsets(c, 0)) = diagonal;
-        if (!ok && c < bad) bad = c;
+        values(offsets(k, 0)) = diagonal;
+        if (!ok && k < bad) bad = k;
       },
-      Kokkos::Min<LocalOrdinal>(first_bad));
+      Kokkos::Min<LocalOrdinal>(first_bad_row));
+  const LocalOrdinal owned = lay.ownedCells();
+  LocalOrdinal first_bad = owned;
+  if (first_bad_row < rows) Kokkos::deep_copy(first_bad, Kokkos::subview(row_cell, first_bad_row));
 
   // A bad coefficient on any rank stops every rank (so none waits in a collective), with the
   // message of the lowest rank that found one.
@@ -609,7 +750,51 @@ void PressureSolver<Dim>::apply(const Field<Dim>& x, Field<Dim>& y) const
   if (!impl_->assembled) throw std::logic_error("PressureSolver::apply before assemble");
   requireOneColumn(x.columns(), x.name(), "x");
   requireOneColumn(y.columns(), y.name(), "y");
-  impl_->matrix->apply(x.owned(), y.owned());
+  const Impl& m = *impl_;
+  if (m.every_cell_a_row) {
+    m.matrix->apply(x.owned(), y.owned());
+    return;
+  }
+  m.gather(x.owned(), *m.rows_x);
+  m.matrix->apply(*m.rows_x, *m.rows_y);
+  m.scatter(*m.rows_y, y.owned());
+}
+
+template <int Dim>
+bool PressureSolver<Dim>::excludeCells(const CellMask& excluded)
+{
+  Impl& m = *impl_;
+  const Layout<Dim>& lay = *m.layout;
+  const bool given = excluded.extent(0) > 0, held = m.excluded.extent(0) > 0;
+  if (given && excluded.extent(0) < std::size_t(lay.ownedCells()))
+    throw std::invalid_argument("PressureSolver::excludeCells: the mask has fewer entries than owned cells");
+  // Owned cells whose state differs from the graph's, on this rank, then on any.
+  long long changed = 0, changed_anywhere = 0;
+  const auto now = excluded;
+  const auto before = m.excluded;
+  Kokkos::parallel_reduce(
+      "pressure solver: excluded cells changed", Kokkos::RangePolicy<ExecutionSpace>(0, lay.ownedCells()),
+      KOKKOS_LAMBDA(const LocalOrdinal c, long long& count) {
+        const bool out_now = given && now(c) != 0, out_before = held && before(c) != 0;
+        if (out_now != out_before) ++count;
+      },
+      changed);
+  Teuchos::reduceAll(*lay.comm(), Teuchos::REDUCE_SUM, changed, Teuchos::outArg(changed_anywhere));
+  if (changed_anywhere == 0) return false;
+  if (given) {
+    m.excluded = CellMask("pressure solver excluded cells", excluded.extent(0));
+    Kokkos::deep_copy(m.excluded, excluded);
+  } else {
+    m.excluded = CellMask();
+  }
+  m.buildGraph();
+  return true;
+}
+
+template <int Dim>
+long long PressureSolver<Dim>::rows() const
+{
+  return impl_->global_rows;
 }
 
 template <int Dim>
@@ -624,8 +809,14 @@ PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>
   const Settings& s = m.settings;
   PressureSolveReport report;
 
-  const MultiVector& b = rhs.owned();
-  MultiVector& x = solution.owned();
+  // Over the rows: the fields' owned parts themselves, or gathered from the cells that have rows.
+  const bool gathered = !m.every_cell_a_row;
+  if (gathered) {
+    m.gather(rhs.owned(), *m.rows_b);
+    m.gather(solution.owned(), *m.rows_x);
+  }
+  const MultiVector& b = gathered ? *m.rows_b : rhs.owned();
+  MultiVector& x = gathered ? *m.rows_x : solution.owned();
   if (m.residual.is_null()) {
     m.residual = Teuchos::rcp(new MultiVector(b.getMap(), 1, false));
     m.guess = Teuchos::rcp(new MultiVector(b.getMap(), 1, false));
@@ -638,12 +829,13 @@ PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>
   measure.norm = residual_target > 0 ? Belos::InfNorm : Belos::TwoNorm;
   if (residual_target > 0 && residual_weight) {
     requireOneColumn(residual_weight->columns(), residual_weight->name(), "residual weight");
-    measure.weight = residual_weight->owned().getVector(0);
+    if (gathered) m.gather(residual_weight->owned(), *m.rows_weight);
+    measure.weight = (gathered ? *m.rows_weight : residual_weight->owned()).getVector(0);
     measure.scratch = m.weighted;
   }
   const double b_norm = measure(b);
   if (b_norm == 0) {  // A is SPD, so the answer is exactly zero
-    x.putScalar(0);
+    solution.owned().putScalar(0);
     solution.exchangeHalo();
     report.converged = true;
     return report;
@@ -691,6 +883,7 @@ PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>
     }
     report.solve_seconds += secondsSince(start);
   }
+  if (gathered) m.scatter(x, solution.owned());
   solution.exchangeHalo();
   ++m.solves_since_setup;
 

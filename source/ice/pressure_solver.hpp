@@ -9,8 +9,11 @@
 // faces are walls: no flux (zero normal gradient of δp). The matrix is symmetric positive definite
 // when κ > 0 and β ≥ 0; it is solved with Belos CG preconditioned by MueLu smoothed aggregation.
 //
-// The sparsity graph is built once per layout; assemble() only replaces values, and solve() builds
-// or reuses the preconditioner. See doc/ice-pressure.md for the matrix entries and the settings.
+// The sparsity graph is built once per layout and set of excluded cells; assemble() only replaces
+// values, and solve() builds or reuses the preconditioner. Cells that the caller excludes (cells that
+// rigid bodies fill, walls to the fluids) have no row: the matrix and the preconditioner are built
+// over the other cells, numbered consecutively rank by rank. See doc/ice-pressure.md for the matrix
+// entries and the settings.
 //
 // Belos and MueLu are confined to pressure_solver.cpp (they are costly to compile); this header
 // only forward-declares the matrix type.
@@ -72,8 +75,23 @@ class PressureSolver {
   /// The settings in use, defaults filled in.
   const Teuchos::ParameterList& settings() const;
 
+  /// One entry per overlap cell (owned cells first, then ghosts, as the layout orders them); nonzero:
+  /// the cell is left out of the equation.
+  using CellMask = Kokkos::View<unsigned char*, MemorySpace>;
+  /// Leaves out of the equation the owned cells whose entry of `excluded` is nonzero (an empty view:
+  /// none): they get no row, and a face towards one is a wall (no entry; its coefficient is not
+  /// read). solve() returns δp = 0 there and apply() y = 0. Only the owned entries are read; whether
+  /// a neighbour on another rank is excluded is its owner's entry. When the set differs from the one
+  /// the graph was built for, on any rank, the graph is built again (the matrix then needs an
+  /// assemble() and the next solve a fresh preconditioner) and true is returned, on every rank.
+  /// Collective.
+  bool excludeCells(const CellMask& excluded);
+  /// Rows of the matrix over all ranks (the cells not excluded).
+  long long rows() const;
+
   /// Fills the matrix values for this step (the graph is not rebuilt).
-  ///   mixture_compressibility: κ_c (1/Pa), 1 column, owned cells read; must be > 0.
+  ///   mixture_compressibility: κ_c (1/Pa), 1 column, owned cells read; must be > 0 (excluded cells:
+  ///     not read).
   ///   face_coefficient: β_f (m^3/kg), 1 column, on the lower face of each cell (face_field.hpp);
   ///     must be >= 0. Its halo is exchanged here, because the upper face of an owned cell is the
   ///     lower face of its neighbour, which may live on another rank.
@@ -102,13 +120,15 @@ class PressureSolver {
                             const Field<Dim>* residual_weight = nullptr);
   static constexpr int kSolveKinds = 4;
 
-  /// y = A x on the owned cells (x's ghosts are not read; y's ghosts are not written).
+  /// y = A x on the owned cells (x's ghosts are not read; y's ghosts are not written; y = 0 in the
+  /// excluded cells).
   void apply(const Field<Dim>& x, Field<Dim>& y) const;
 
   /// The next solve does a full preconditioner setup, whatever the reuse interval.
   void requestPreconditionerRebuild();
 
-  /// The assembled matrix (rows: owned cells; column map built by Tpetra from the stencil).
+  /// The assembled matrix (rows: the owned cells, or with excluded cells the others, numbered
+  /// consecutively from rank 0 up; column map built by Tpetra from the stencil).
   Teuchos::RCP<const Matrix> matrix() const;
   const Layout<Dim>& layout() const;
 

@@ -476,6 +476,101 @@ TYPED_TEST(PressureSolverTest, SameSolutionOnOneAndManyRanks)
   EXPECT_LE(difference, 1e-8);
 }
 
+// (c') Excluded cells (cells that rigid bodies fill, IceSolver::closedCells) have no row, and a face
+// towards one is a wall: the answer in the other cells is that of the full system in which every
+// face of an excluded cell has a zero coefficient and its right-hand side is zero (such a row is
+// decoupled and its answer zero), and the excluded cells get exactly zero. A block of cells across
+// patch (and, on 2 and 3 ranks, rank) boundaries is excluded.
+TYPED_TEST(PressureSolverTest, ExcludedCellsHaveNoRowAndAreWalls)
+{
+  constexpr int Dim = TypeParam::value;
+  const Grid<Dim> grid = smallGrid<Dim>();
+  const auto layout = makeLayout(grid);
+  const double tolerance = 1e-12;
+  const auto length = [&](int d) { return grid.spacing()[d] * double(grid.cells()[d]); };  // lower corner at 0
+  const auto excludedAt = [&](const std::array<double, 3>& x) {
+    return x[0] > 0.25 * length(0) && x[0] < 0.6 * length(0) && x[1] > 0.3 * length(1) && x[1] < 0.7 * length(1);
+  };
+  const auto rhsAt = [&](const std::array<double, 3>& x) { return excludedAt(x) ? 0.0 : manufactured<Dim>(grid, x); };
+
+  // The full system with the excluded cells' faces shut.
+  Problem<Dim> full(layout);
+  smoothCoefficients(full);
+  setLowerFaces(full.beta, [&](int d, const std::array<double, 3>& x) {
+    std::array<double, 3> below = x, above = x;
+    below[d] -= 0.5 * grid.spacing()[d];
+    above[d] += 0.5 * grid.spacing()[d];
+    return excludedAt(below) || excludedAt(above) ? 0.0 : 1e-3 * (1.0 + 0.9 * std::cos(3.0 * x[0] + 2.0 * x[1] + x[2] + d));
+  });
+  setCells(full.rhs, rhsAt);
+  PressureSolver<Dim> full_solver(layout, settings("muelu", tolerance));
+  full_solver.assemble(full.kappa, full.beta, full.dt);
+  full.solution.fill(0.0);
+  const PressureSolveReport full_report = full_solver.solve(full.rhs, full.solution);
+  ASSERT_TRUE(full_report.converged) << describe(full_report);
+
+  // The same with the cells excluded; the coefficients on their faces are left as they were (the
+  // solver must not read them).
+  Problem<Dim> cut(layout);
+  smoothCoefficients(cut);
+  setCells(cut.rhs, [&](const std::array<double, 3>& x) { return excludedAt(x) ? 1e3 : rhsAt(x); });
+  typename PressureSolver<Dim>::CellMask excluded("excluded", layout->overlapCells());
+  long long excluded_owned = 0;
+  {
+    const auto host = Kokkos::create_mirror_view(excluded);
+    for (LocalOrdinal c = 0; c < layout->overlapCells(); ++c) {
+      host(c) = excludedAt(centre(*layout, c)) ? 1 : 0;
+      if (c < layout->ownedCells() && host(c)) ++excluded_owned;
+    }
+    Kokkos::deep_copy(excluded, host);
+  }
+  const long long excluded_total = globalSum(excluded_owned);
+  ASSERT_GT(excluded_total, 0);
+  PressureSolver<Dim> solver(layout, settings("muelu", tolerance));
+  EXPECT_EQ(solver.rows(), grid.cellCount());
+  EXPECT_TRUE(solver.excludeCells(excluded));
+  EXPECT_FALSE(solver.excludeCells(excluded));  // the same set: the graph is kept
+  EXPECT_EQ(solver.rows(), grid.cellCount() - excluded_total);
+  EXPECT_EQ(static_cast<long long>(solver.matrix()->getGlobalNumRows()), grid.cellCount() - excluded_total);
+  solver.assemble(cut.kappa, cut.beta, cut.dt);
+  cut.solution.fill(7.0);  // a guess in the excluded cells must not survive
+  const PressureSolveReport report = solver.solve(cut.rhs, cut.solution);
+  ASSERT_TRUE(report.converged) << describe(report);
+
+  // Each answer is within cond(A) * tolerance of the exact one (which they share in the cells with
+  // rows), so they differ by at most the sum of the two bounds.
+  const double condition = std::max(conditionBound(*full_solver.matrix()), conditionBound(*solver.matrix()));
+  const double difference = relativeDifference(cut.solution.owned(), full.solution.owned());
+  double largest_excluded = 0;
+  {
+    const auto v = cut.solution.view();
+    for (LocalOrdinal c = 0; c < layout->overlapCells(); ++c)
+      if (excludedAt(centre(*layout, c))) largest_excluded = std::max(largest_excluded, std::abs(v(c, 0)));
+  }
+  std::ostringstream line;
+  line << Dim << "-D " << excluded_total << " of " << grid.cellCount() << " cells excluded: " << describe(report)
+       << "; full system: " << describe(full_report) << "; difference " << std::scientific << std::setprecision(2)
+       << difference << ", cond(A) <= " << condition;
+  printLine(line.str());
+  EXPECT_LE(difference, 2 * condition * tolerance);
+  EXPECT_EQ(globalMax(largest_excluded), 0.0);  // ghosts included: exact zeros, exchanged
+
+  // apply(): the same product as the full matrix's in the cells with rows, zero in the others.
+  Field<Dim> y_cut(layout, Location::Cell, 1, "y cut"), y_full(layout, Location::Cell, 1, "y full");
+  solver.apply(full.solution, y_cut);
+  full_solver.apply(full.solution, y_full);
+  {
+    auto v = y_full.view();
+    for (LocalOrdinal c = 0; c < layout->ownedCells(); ++c)
+      if (excludedAt(centre(*layout, c))) v(c, 0) = 0.0;
+  }
+  EXPECT_LE(relativeDifference(y_cut.owned(), y_full.owned()), 1e3 * kEpsilon);  // same sums, round-off only
+
+  // No cell excluded any more: every cell has its row again.
+  EXPECT_TRUE(solver.excludeCells(typename PressureSolver<Dim>::CellMask()));
+  EXPECT_EQ(solver.rows(), grid.cellCount());
+}
+
 // (d) Water column in air, 2-D 128 x 64, dt = 1e-4 s: beta jumps 833x and V kappa 10^4x at the
 // interface. MueLu needs fewer than 50 CG iterations; Jacobi and no preconditioner are printed.
 TEST(PressureSolverRealistic, WaterColumnConvergesInFewIterationsWithMueLu)

@@ -156,6 +156,19 @@ KOKKOS_INLINE_FUNCTION bool shutFace(const Mask& closed, LocalOrdinal c, LocalOr
   return closed(c) || (l >= 0 && closed(l));
 }
 
+// Whether cell c is closed and every face neighbour it has is closed too (domain walls count as
+// closed): such a cell has no row in the pressure matrix (IceSolver::updatePressureRows).
+template <int Dim, class Mask, class Neighbours>
+KOKKOS_INLINE_FUNCTION bool closedTwoDeep(const Mask& closed, const Neighbours& neighbours, LocalOrdinal c)
+{
+  if (!closed(c)) return false;
+  for (int f = 0; f < 2 * Dim; ++f) {
+    const LocalOrdinal n = neighbours(c, f);
+    if (n >= 0 && !closed(n)) return false;
+  }
+  return true;
+}
+
 // Calls f(std::integral_constant<int, N>()): N = 2 for two materials (two fluids; the exchange then
 // takes its two-material form) and N = 4 for four (two fluids and two solids, as the seed scene's
 // water, air, sand and bed), so that the kernels' loops over materials have constant bounds, else
@@ -370,26 +383,14 @@ void IceSolver<Dim>::updatePressureRows()
       "ice::pressureRowsChanged", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
       KOKKOS_LAMBDA(const LocalOrdinal c, long long& opened, long long& gain) {
         if (without(c) && !closed(c)) ++opened;
-        if (without(c) || !closed(c)) return;
-        for (int f = 0; f < 2 * Dim; ++f) {
-          const LocalOrdinal n = neighbours(c, f);
-          if (n >= 0 && !closed(n)) return;
-        }
-        ++gain;
+        if (!without(c) && closedTwoDeep<Dim>(closed, neighbours, c)) ++gain;
       },
       counts[0], counts[1]);
   Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_SUM, 2, counts, global);
   if (global[0] == 0 && double(global[1]) < kPressureRowsGain * double(layout_->grid().cellCount())) return;
   Kokkos::parallel_for(
       "ice::cellsWithoutPressureRow", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
-      KOKKOS_LAMBDA(const LocalOrdinal c) {
-        bool deep = closed(c);
-        for (int f = 0; f < 2 * Dim && deep; ++f) {
-          const LocalOrdinal n = neighbours(c, f);
-          if (n >= 0 && !closed(n)) deep = false;
-        }
-        without(c) = deep ? 1 : 0;
-      });
+      KOKKOS_LAMBDA(const LocalOrdinal c) { without(c) = closedTwoDeep<Dim>(closed, neighbours, c) ? 1 : 0; });
   pressure_solver_->excludeCells(without_row_);
 }
 

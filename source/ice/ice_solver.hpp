@@ -140,7 +140,7 @@ class IceSolver {
   /// step's equilibration phase. Such a cell is a wall for the fluids: every face it has is closed
   /// to them, and the fluid phases leave it as it is (its traces of fluid, its pressure) instead of
   /// computing what would change nothing there; a third of the seed scene's cells lie inside its bed.
-  using CellMask = Kokkos::View<unsigned char*, MemorySpace>;
+  using CellMask = typename PressureSolver<Dim>::CellMask;  // the mask type excludeCells() takes
   const CellMask& closedCells() const { return closed_; }
   /// The cells with 1 in closedCells over all ranks, at the last equilibration phase.
   long long closedCellCount() const { return closed_count_; }

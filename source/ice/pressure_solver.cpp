@@ -301,10 +301,8 @@ void PressureSolver<Dim>::Impl::buildGraph()
   for (LocalOrdinal c = 0; c < owned; ++c)
     if (!any_excluded_here || !excluded_host(c)) cells.push_back(c);
   const long long local_rows = static_cast<long long>(cells.size());
-  long long excluded_cells = owned - local_rows, excluded_total = 0;
-  Teuchos::reduceAll(*lay.comm(), Teuchos::REDUCE_SUM, excluded_cells, Teuchos::outArg(excluded_total));
-  every_cell_a_row = excluded_total == 0;
   Teuchos::reduceAll(*lay.comm(), Teuchos::REDUCE_SUM, local_rows, Teuchos::outArg(global_rows));
+  every_cell_a_row = global_rows == lay.grid().cellCount();  // every cell is owned by one rank
 
   // Each overlap cell's global row id (-1: no row). Without excluded cells the rows are the layout's
   // owned cells with their global ids; with them, rank r numbers its rows after those of ranks < r,

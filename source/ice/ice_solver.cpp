@@ -275,6 +275,7 @@ IceSolver<Dim>::IceSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>>
                          "their heat exchange with the fluids would be missing");
       roles_.lagrangian[m] = 1;
       roles_.rigid[m] = solid->rigid ? 1 : 0;
+      roles_.reference_inside[m] = solid->reference_pressure_inside && !solid->rigid ? 1 : 0;
       any_rigid_ = any_rigid_ || solid->rigid;
       roles_.any_solid = true;
       bulk_modulus_[m] = solid->bulk_modulus;
@@ -1094,13 +1095,12 @@ void IceSolver<Dim>::momentumSourcePhase(CellState<Dim>& state, double dt)
             };
             const double rho_c = fluidDensity(c);
             // The pressure that acts: the cell's own where its fluids set it, the reference where a
-            // deformable solid fills it (kPoreShareLow).
+            // solid with `interior_pressure: reference` fills it (kPoreShareLow).
             const auto acting = [&](LocalOrdinal cell) {
               double fluid = 0, solid = 0;
               for (int m = 0; m < nm; ++m) {
-                if (roles.rigid[m]) continue;
-                if (roles.lagrangian[m]) solid += theta(cell, m);
-                else fluid += theta(cell, m);
+                if (roles.reference_inside[m]) solid += theta(cell, m);
+                else if (!roles.lagrangian[m]) fluid += theta(cell, m);
               }
               const double share = fluid + solid > 0 ? fluid / (fluid + solid) : 1.0;
               const double weight = Kokkos::Experimental::fmin(

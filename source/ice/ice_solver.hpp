@@ -78,6 +78,7 @@ struct IceStepReport {
 struct MaterialRoles {
   ice::MaterialArray<int> lagrangian{};
   ice::MaterialArray<int> rigid{};
+  ice::MaterialArray<int> reference_inside{};  // a solid that feels the reference pressure where it fills a cell
   bool any_solid = false;
 };
 
@@ -94,6 +95,7 @@ struct SolidProperties {
   double bulk_modulus = 0.0;  // K of its equation of state (Pa)
   double density = 0.0;       // at rest (kg/m^3)
   bool rigid = false;
+  bool reference_pressure_inside = false;  // `interior_pressure: reference`
 };
 
 template <int Dim>

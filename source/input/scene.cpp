@@ -750,6 +750,17 @@ std::string readTyped(ParameterList& list, const std::string& path, int dimensio
   return type;
 }
 
+}  // namespace
+
+std::string defaultInteriorPressure(const std::string& model_type)
+{
+  // A plastic body's particles shear off their lattice (the seed scene's sand); an elastic body's
+  // stay on it, and its interior takes the pressure that the pressure equation solved for.
+  return model_type == "tresca" || model_type == "drucker_prager" ? "reference" : "cell";
+}
+
+namespace {
+
 std::vector<MaterialSpec> readMaterials(ParameterList& section, int dimension)
 {
   const std::string path = kRoot + ".materials";
@@ -787,6 +798,7 @@ std::vector<MaterialSpec> readMaterials(ParameterList& section, int dimension)
       ParameterList& model = list.sublist("model");
       const std::string model_path = material_path + ".model";
       const std::string type = readTyped(model, model_path, dimension, validSolidModelParameters, solidModelTypes());
+      if (!list.isParameter("interior_pressure")) list.set("interior_pressure", defaultInteriorPressure(type));
       if (type == "drucker_prager") {
         const double friction = model.get<double>("friction_angle");
         if (model.get<double>("dilatancy_angle") > friction) {

@@ -130,6 +130,10 @@ const std::vector<std::string>& materialKinds();         // fluid, solid
 const std::vector<std::string>& equationOfStateTypes();  // linear_water, ideal_gas, tait
 const std::vector<std::string>& solidModelTypes();       // linear_elastic, neo_hookean, tresca, ...
 const std::vector<std::string>& regionShapes();          // box, polygon, half_plane
+
+/// A solid's `interior_pressure` when the scene does not give it: "reference" for the plastic
+/// models (tresca, drucker_prager), whose particles shear off their lattice, "cell" otherwise.
+std::string defaultInteriorPressure(const std::string& model_type);
 const std::vector<std::string>& outputFieldNames();      // cell fields, then particle fields
 std::vector<std::string> boundaryFaces(int dimension);   // x-, x+, y-, y+ (, z-, z+)
 

@@ -328,6 +328,16 @@ RCP<ParameterList> buildMaterial(const std::string& kind)
     define(*material, "density", 1000.0, "Density of the solid at rest.", required(positive("kg/m^3")));
     defineSection(*material, "model", "Constitutive model; keys depend on its `type`.", true, true);
     define(*material, "particles_per_cell", 2, "Material points per cell in each direction.", atLeast(1));
+    define(*material, "interior_pressure", std::string("cell"),
+           "The pressure that acts on the solid, and on the fluid beside it, in the cells it fills (the fluids "
+           "below 5-15 % of the fluid and solid volume): `cell`, the cell's own (the pressure the coupled pressure "
+           "equation solved for, with the solid's motion in it: a body lighter than the fluid moves mostly by "
+           "it), or `reference`, the still fluid's hydrostatic pressure (its gradient is the buoyancy), for a "
+           "body whose particles shear off their lattice, so that their boxes cover a cell only to ~1 % and the "
+           "bulk modulus turns that into pressure noise (doc/mpmice.md, \"The pressure that acts where a solid "
+           "fills the cell\"). Not used by a rigid body.",
+           derivedDefault(oneOf({"cell", "reference"}),
+                          "`reference` for the plastic models (tresca, drucker_prager), `cell` for the elastic ones"));
   }
   return material;
 }

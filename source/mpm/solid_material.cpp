@@ -72,6 +72,10 @@ std::vector<SolidMaterial> solidMaterials(const Scene& scene)
     SolidMaterial solid{spec.name, i, density, ppc, solidModelFromParameters(model, spec.name)};
     const std::string type = model.get<std::string>("type");
     solid.rigid = type == "rigid";
+    const std::string interior = spec.parameters.isParameter("interior_pressure")
+                                     ? spec.parameters.get<std::string>("interior_pressure")
+                                     : defaultInteriorPressure(type);
+    solid.reference_pressure_inside = !solid.rigid && interior == "reference";
     if (solid.rigid)
       solid.bulk_modulus = kRigidBulkModulus;
     else if (type == "neo_hookean")

@@ -19,6 +19,9 @@ struct SolidMaterial {
   /// pressure and pressure equation: the model's elastic K, or kRigidBulkModulus for a rigid body.
   double bulk_modulus = 0.0;
   bool rigid = false;          ///< moves at a prescribed velocity (model type rigid)
+  /// Where it fills a cell, the fluids' hydrostatic reference pressure acts on it instead of the
+  /// cell's own (`interior_pressure: reference`).
+  bool reference_pressure_inside = false;
 };
 
 /// The stiffness a rigid material is given in the coupled step's equilibration and pressure

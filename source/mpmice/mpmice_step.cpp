@@ -36,7 +36,7 @@ MpmIceStep<Dim>::MpmIceStep(const Scene& scene, std::shared_ptr<const Layout<Dim
     std::vector<SolidProperties> solids;
     if (mpm_)
       for (const mpm::SolidMaterial& s : mpm_->materials())
-        solids.push_back(SolidProperties{s.scene_index, s.bulk_modulus, s.density, s.rigid});
+        solids.push_back(SolidProperties{s.scene_index, s.bulk_modulus, s.density, s.rigid, s.reference_pressure_inside});
     ice_ = std::make_unique<IceSolver<Dim>>(scene, layout_, solids);
     ice_->setSolidReferencePressure(state.pressure);
     ice_->setKinematicSolids(scene.mpm.coupling == "staggered");

@@ -373,6 +373,13 @@ TEST_F(SceneTest, UnknownSolidModelListsTypes)
                            "allowed: linear_elastic, neo_hookean, tresca, drucker_prager, rigid"});
 }
 
+TEST_F(SceneTest, UnknownInteriorPressureListsChoices)
+{
+  const std::string message =
+      errorOf(replaced(kFullScene, "model: {type: tresca", "interior_pressure: fluid\n      model: {type: tresca"));
+  expectMentions(message, {"cfdmpm.materials.sand.interior_pressure", "got 'fluid'", "cell, reference"});
+}
+
 TEST_F(SceneTest, UnknownRegionShapeListsShapes)
 {
   const std::string message = errorOf(replaced(kFullScene, "shape: box", "shape: sphere"));

@@ -341,6 +341,10 @@ TEST_F(SceneTest, EveryMaterialKindAndModelTypeIsAccepted)
   EXPECT_EQ(soil.get<std::string>("fit"), "outer_cone");
   EXPECT_EQ(scene.materials[5].parameters.get<int>("particles_per_cell"), 2);
   EXPECT_EQ(scene.materials[7].parameters.sublist("model").get<Array<double>>("velocity"), Array<double>(Teuchos::tuple(0.1, 0.0)));
+  // The pressure inside a solid: the cell's for the elastic models, the reference for the plastic ones.
+  const std::vector<std::string> interior{"cell", "cell", "reference", "reference", "cell"};
+  for (int m = 3; m < 8; ++m)
+    EXPECT_EQ(scene.materials[m].parameters.get<std::string>("interior_pressure"), interior[m - 3]) << m;
 }
 
 TEST_F(SceneTest, CommentsDirectivesAndDocumentMarkersAroundTheRootAreAllowed)

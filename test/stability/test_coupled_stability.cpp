@@ -80,7 +80,7 @@ TEST(StabilityAddedMass, LightDiskMonolithicHoldsStaggeredFails)
 {
   std::vector<SweepRow> rows;
   double staggered_fails_below = 0;
-  for (const double density : {2000.0, 500.0, 100.0}) {
+  for (const double density : {2000.0, 500.0, 100.0, 10.0}) {
     const double ratio = density / 1000.0;
     for (const std::string coupling : {"monolithic", "staggered"}) {
       const DiskOutcome d = runDisk(density, coupling);
@@ -92,7 +92,10 @@ TEST(StabilityAddedMass, LightDiskMonolithicHoldsStaggeredFails)
       if (coupling == "monolithic") {
         EXPECT_TRUE(holds) << density << ": growth " << d.growth << " " << d.failure;
         // The issue's 10 % on the acceleration holds for the disks heavier than a fifth of the
-        // water (test_coupled's bound); the lighter disk's is reported (doc/stability.md, case b).
+        // water (test_coupled's bound); the lighter disks' is reported (doc/stability.md, case b):
+        // at 20 cells per diameter an elastic mode inside them grows (at 10 kg/m³ to several m/s
+        // inside the disk), which the fitted acceleration does not bound. The 10 kg/m³ disk at 10
+        // cells per diameter is test_coupled's LightBody case (10 %).
         if (ratio >= 0.5) {
           EXPECT_NEAR(d.ratio, 1.0, 0.10) << density;
         }
@@ -114,25 +117,6 @@ TEST(StabilityAddedMass, LightDiskMonolithicHoldsStaggeredFails)
   if (staggered_fails_below > 0) thresholds.push_back({"staggered fails", staggered_fails_below});
   writeSweep(*world(), "stability_b_added_mass", "density ratio solid / water",
              "|a / potential flow - 1| + velocity oscillation (failed: 10)", rows, thresholds);
-}
-
-// The issue's lightest disk, ρs = 10 kg/m³ (ρs/ρw = 0.01; potential flow: 0.98 g upwards, its own
-// inertia 1 % of the added mass), monolithic step only (the staggered one fails from 0.5 on). It
-// does not hold: measured on 2026-12-03 (~45 minutes on a loaded core), the run stops with the
-// cell-centred exchange not finite at cell (115, 101) (the disk started centred on (100, 100), 10
-// cells in radius; doc/stability.md, case b). Disabled because of its cost; run it with
-// `test_coupled_stability --gtest_also_run_disabled_tests --gtest_filter='*Lightest*'`. It checks
-// what issue 14 asks of every failure: that it stops with the cell or particle named, and reports
-// the acceleration when the run holds.
-TEST(StabilityAddedMass, DISABLED_LightestDiskStopsNamedOrHolds)
-{
-  const DiskOutcome d = runDisk(10.0, "monolithic");
-  report(10.0, "monolithic", d);
-  if (d.failure.empty()) {
-    EXPECT_LE(d.growth, kGrowthBound);
-  } else {
-    EXPECT_TRUE(namesCellOrParticle(d.failure)) << "a failure that names nothing: " << d.failure;
-  }
 }
 
 }  // namespace

@@ -79,9 +79,12 @@ constexpr double kFillMinimum = 1e-3;
 // The pressure of a cell that a deformable solid nearly fills is not a fluid's: the particles' boxes
 // cover a cell of a shearing sand only to within ~1 % (extremes of several %), and the solid's bulk
 // modulus turns that into pressure (3e5 Pa per 1 % at E = 5e7 Pa), which would act on the solid
-// and on the fluid beside it. Where the fluids' share of the fluid and deformable solid volume is
-// below kPoreShareLow the solids and fluids feel the reference pressure there (the still fluid's,
-// whose gradient is the buoyancy); above kPoreShareHigh the cell's own pressure; linear between.
+// and on the fluid beside it. Where the fluids' share of the volume of fluids and of the solids
+// with `interior_pressure: reference` is below kPoreShareLow the solids and fluids feel the
+// reference pressure there (the still fluid's, whose gradient is the buoyancy); above
+// kPoreShareHigh the cell's own pressure; linear between. An elastic body (`cell`, its default)
+// feels its cells' own pressure: a light body moves mostly by the pressure the pressure equation
+// solved for with its motion in it, which inside it is far from hydrostatic (doc/mpmice.md).
 // Measured (a submerged sand column, E = 5e7 Pa, 20 mm): with both bounds at 0.01 it failed between
 // 0.24 and 0.28 s, at 0.1 and with these it held to 0.4 s; the pressure it had let act failed it
 // at 0.14 s (doc/mpmice.md).

@@ -198,7 +198,17 @@ class IceSolver {
   /// The momentum sources and the cell-centred exchange still act on them, and their velocity
   /// change reaches the particles' velocities (their positions the next step). Off by default: the
   /// monolithic coupling, where the solids' response to the pressure is in the pressure equation.
-  void setKinematicSolids(bool on) { kinematic_solids_ = on; }
+  ///
+  /// On, the pressure equation holds no response of theirs to the pressure, so the pressure inside
+  /// a deformable solid is not the one that moves it: every one takes the reference there
+  /// (`interior_pressure: reference`), as the staggered coupling did before the key existed.
+  void setKinematicSolids(bool on)
+  {
+    kinematic_solids_ = on;
+    if (on)
+      for (int m = 0; m < ice::kMaxMaterials; ++m)
+        if (roles_.lagrangian[m] && !roles_.rigid[m]) roles_.reference_inside[m] = 1;
+  }
   /// The solids' volume from their particles (mpm.solid_volume: particles): before the first
   /// pressure residual and after every correction, `predict(state, dt)` sets solidVolumeChange to
   /// each solid's change of volume fraction over the step as its particles would make it with the

@@ -335,7 +335,8 @@ RCP<ParameterList> buildMaterial(const std::string& kind)
            "it), or `reference`, the still fluid's hydrostatic pressure (its gradient is the buoyancy), for a "
            "body whose particles shear off their lattice, so that their boxes cover a cell only to ~1 % and the "
            "bulk modulus turns that into pressure noise (doc/mpmice.md, \"The pressure that acts where a solid "
-           "fills the cell\"). Not used by a rigid body.",
+           "fills the cell\"). Not used by a rigid body; with `mpm.coupling: staggered` every deformable solid takes "
+           "`reference` (that pressure equation holds no response of the solids).",
            derivedDefault(oneOf({"cell", "reference"}),
                           "`reference` for the plastic models (tresca, drucker_prager), `cell` for the elastic ones"));
   }

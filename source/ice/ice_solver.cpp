@@ -1036,7 +1036,7 @@ void IceSolver<Dim>::momentumSourcePhase(CellState<Dim>& state, double dt)
   const auto T = state.temperature.view();
   const auto eos = eos_;
   const auto mu = viscosity_;
-  const auto roles = roles_;
+  const auto roles = momentumRoles();
   const bool with_solids = roles_.any_solid;
   typename Field<Dim>::ConstView share[3];
   for (int d = 0; d < Dim; ++d) share[d] = solid_face_share_.direction(d).view();

@@ -198,17 +198,7 @@ class IceSolver {
   /// The momentum sources and the cell-centred exchange still act on them, and their velocity
   /// change reaches the particles' velocities (their positions the next step). Off by default: the
   /// monolithic coupling, where the solids' response to the pressure is in the pressure equation.
-  ///
-  /// On, the pressure equation holds no response of theirs to the pressure, so the pressure inside
-  /// a deformable solid is not the one that moves it: every one takes the reference there
-  /// (`interior_pressure: reference`), as the staggered coupling did before the key existed.
-  void setKinematicSolids(bool on)
-  {
-    kinematic_solids_ = on;
-    if (on)
-      for (int m = 0; m < ice::kMaxMaterials; ++m)
-        if (roles_.lagrangian[m] && !roles_.rigid[m]) roles_.reference_inside[m] = 1;
-  }
+  void setKinematicSolids(bool on) { kinematic_solids_ = on; }
   /// The solids' volume from their particles (mpm.solid_volume: particles): before the first
   /// pressure residual and after every correction, `predict(state, dt)` sets solidVolumeChange to
   /// each solid's change of volume fraction over the step as its particles would make it with the
@@ -269,6 +259,18 @@ class IceSolver {
     MaterialRoles roles = roles_;
     if (kinematic_solids_)
       for (int m = 0; m < ice::kMaxMaterials; ++m) roles.rigid[m] = roles.rigid[m] || roles.lagrangian[m];
+    return roles;
+  }
+  /// The roles as the momentum sources see them: with kinematic solids the pressure equation
+  /// holds no response of theirs to the pressure, so the pressure inside a deformable solid is not
+  /// the one that moves it, and every one takes the reference there (`interior_pressure:
+  /// reference`), as the staggered coupling did before the key existed.
+  MaterialRoles momentumRoles() const
+  {
+    MaterialRoles roles = roles_;
+    if (kinematic_solids_)
+      for (int m = 0; m < ice::kMaxMaterials; ++m)
+        if (roles.lagrangian[m] && !roles.rigid[m]) roles.reference_inside[m] = 1;
     return roles;
   }
   ice::MaterialArray<ice::Eos> eos_;

@@ -130,12 +130,12 @@ const std::vector<std::string>& materialKinds();         // fluid, solid
 const std::vector<std::string>& equationOfStateTypes();  // linear_water, ideal_gas, tait
 const std::vector<std::string>& solidModelTypes();       // linear_elastic, neo_hookean, tresca, ...
 const std::vector<std::string>& regionShapes();          // box, polygon, half_plane
+const std::vector<std::string>& outputFieldNames();      // cell fields, then particle fields
+std::vector<std::string> boundaryFaces(int dimension);   // x-, x+, y-, y+ (, z-, z+)
 
 /// A solid's `interior_pressure` when the scene does not give it: "reference" for the plastic
 /// models (tresca, drucker_prager), whose particles shear off their lattice, "cell" otherwise.
 std::string defaultInteriorPressure(const std::string& model_type);
-const std::vector<std::string>& outputFieldNames();      // cell fields, then particle fields
-std::vector<std::string> boundaryFaces(int dimension);   // x-, x+, y-, y+ (, z-, z+)
 
 /// Reads and validates a scene file. Throws InputError (message: key, value, what is allowed) on
 /// any problem; nothing is written before it returns.

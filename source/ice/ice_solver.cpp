@@ -298,8 +298,10 @@ IceSolver<Dim>::IceSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>>
     if (roles_.lagrangian[m]) continue;
     const double rho = eos_[m].density(scene.initial.pressure, scene.initial.temperature);
     const double kappa = 1.0 / (rho * eos_[m].dp_drho(rho, scene.initial.temperature));
-    if (std::isfinite(kappa) && kappa > 0 && (stiffest_compressibility_ == 0 || kappa < stiffest_compressibility_))
+    if (std::isfinite(kappa) && kappa > 0 && (stiffest_compressibility_ == 0 || kappa < stiffest_compressibility_)) {
       stiffest_compressibility_ = kappa;
+      stiffest_density_ = rho;
+    }
   }
   for (int d = 0; d < 3; ++d) gravity_[d] = d < Dim ? scene.domain.gravity[d] : 0.0;
   for (int f = 0; f < 2 * Dim; ++f) wall_no_slip_[f] = 1, wall_temperature_[f] = -1;
@@ -826,6 +828,8 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
   const double volume = layout_->grid().cellVolume();
   // No fluid with a finite compressibility: every cell's volume residual as it is.
   const double stiffest = stiffest_compressibility_ > 0 ? stiffest_compressibility_ : INFINITY;
+  const double stiffest_density = stiffest_compressibility_ > 0 ? stiffest_density_ : 0.0;
+  const auto mass_density = state.density.view();
   double area[3], dt_per_h[3];
   for (int d = 0; d < Dim; ++d) {
     const double h = layout_->grid().spacing()[d];
@@ -929,15 +933,22 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
           }
           rhs(c, 0) = volume * solid_change - dt * outflow - volume * compression;
           // The outer test's measure: the volume residual weighed by how much softer than the
-          // stiffest fluid the cell is, min(1, κ_stiffest / softness). A residual r leaves a
-          // pressure error of r / softness for the next equilibration to take up, so the test
-          // bounds that error by outer_tolerance / κ_stiffest everywhere (215 Pa at 1e-7 in
-          // water), where the volume alone bounded it in a cell of sand (κ ~1e-5 1/Pa at
-          // E = 1.5e5 Pa) or air at 2e-4 Pa: the seed scene at 5 mm spent its third and fourth
-          // outer iterations on pressure errors of 0.1-1000 Pa in the sand's cells. A boiling
-          // liquid counts as the liquid (its vapour's slope is not what a surplus meets), and a
-          // cell stiffer than the stiffest fluid keeps its volume residual.
-          const double weight = softness > stiffest ? stiffest / softness : 1.0;
+          // stiffest fluid the cell is, min(1, κ_stiffest / softness), and by how much lighter,
+          // max(1, ρ_stiffest / ρ_c) with ρ_c = Σ_m ρ_m θ_m. A residual r leaves a pressure error
+          // δp = r / softness for the next equilibration to take up, and δp moves the cell's
+          // contents by Δt δp / (ρ_c h): the test bounds the pressure error by
+          // outer_tolerance / κ_stiffest in the stiffest fluid (215 Pa at 1e-7 in water) and in
+          // every cell as heavy or heavier (a cell of sand: κ ~1e-5 1/Pa at E = 1.5e5 Pa, where
+          // the volume alone asked for 0.1-1000 Pa: the seed scene at 5 mm spent its third and
+          // fourth outer iterations on them), and by that times ρ_c / ρ_stiffest in a lighter
+          // cell, so that no cell's velocity error exceeds the stiffest fluid's (without the
+          // density factor a gas of 0.1 kg/m^3 kept a 20 Pa error and moved at 4e-4 m/s over a
+          // still surface). A boiling liquid counts as the liquid (its vapour's slope is not what
+          // a surplus meets), and a cell stiffer than the stiffest fluid keeps its volume residual.
+          double cell_density = 0;
+          for (int m = 0; m < nm; ++m) cell_density += mass_density(c, m);
+          const double weight = (softness > stiffest ? stiffest / softness : 1.0) *
+                                (cell_density > 0 && cell_density < stiffest_density ? stiffest_density / cell_density : 1.0);
           outer_weight(c, 0) = weight;
           // A value that is not finite counts as infinite (a NaN would lose every comparison and
           // vanish from the maximum), so that the outer iteration sees it and stops.

@@ -275,9 +275,11 @@ class IceSolver {
   }
   ice::MaterialArray<ice::Eos> eos_;
   ice::MaterialArray<double> bulk_modulus_;  // solids: K of their equation of state (Pa)
-  // The stiffest fluid's compressibility at the initial pressure and temperature (1/Pa): the outer
-  // test weighs each cell's volume residual by how much softer than that the cell is.
+  // The stiffest fluid's compressibility and density at the initial pressure and temperature (1/Pa,
+  // kg/m^3): the outer test weighs each cell's volume residual by how much softer than that the
+  // cell is, and by how much lighter (pressureRightHandSide).
   double stiffest_compressibility_ = 0;
+  double stiffest_density_ = 0;
   ice::MaterialArray<double> viscosity_;
   ice::MaterialArray<double> specific_heat_;
   ice::MaterialArray<double> conductivity_;

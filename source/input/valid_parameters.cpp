@@ -263,8 +263,10 @@ void defineIce(ParameterList& ice)
   define(ice, "outer_tolerance", 1.0e-8,
          "The outer iterations stop once max |rhs| / V of the pressure equation is below this: the volume "
          "mismatch of a cell in one step, as a fraction of its volume, weighed in a cell softer than the "
-         "stiffest fluid by how much softer it is, so that it bounds the pressure error by this over the stiffest "
-         "fluid's compressibility (in water 1e-8 is ~20 Pa) in every cell (doc/ice.md).",
+         "stiffest fluid by how much softer it is and in a cell lighter than it by how much lighter, so that it "
+         "bounds the pressure error by this over the stiffest fluid's compressibility (in water 1e-8 is ~20 Pa), "
+         "and in a lighter cell by that times its density over the stiffest fluid's: the velocity error the "
+         "pressure error leaves is bounded alike in every cell (doc/ice.md).",
          positive(""));
   define(ice, "solver_tolerance", 0.0,
          "Relative residual (2-norm) of each linear pressure solve. 0: each solve stops once every cell's "

@@ -1527,10 +1527,13 @@ void IceSolver<Dim>::pressurePhase(CellState<Dim>& state, double dt, IceStepRepo
       break;
     }
     // p = p_eq + Σδp and the faces corrected with this iteration's δp, then the new residual
-    // (with the solids' volumes predicted, only after the prediction below).
-    if (predicted) applyPressureCorrection(state, dt);
+    // (with the solids' volumes predicted, only after the prediction below; after the first
+    // correction of a scene with solids, only after the fractions' refresh below, which changes
+    // the fluxes the residual counts: the correction alone, without its residual, before it).
+    const bool refresh_now = refresh_fractions && report.outer_iterations == 1;
+    if (predicted || refresh_now) applyPressureCorrection(state, dt);
     else residual = pressureRightHandSide(state, dt, true);
-    if (refresh_fractions && report.outer_iterations == 1) {
+    if (refresh_now) {
       // The fluids' face fractions as the advection will take them: its slabs for the corrected
       // face velocities. Kept from the predicted velocities (before), the residual counted each
       // fluid's flux with a slab profile that the advection then did not use; where the water's

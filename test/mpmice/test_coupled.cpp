@@ -72,6 +72,75 @@ TEST(CoupledStep, NeutrallyBuoyantBlockStaysPut)
   EXPECT_LE(moved, bound * end);
 }
 
+// (a) in three dimensions: the same block as a cube (0.05 m, 4 cells across) in a closed 0.2 m tank
+// of 16^3 cells, water to 0.15 m and air above it, on 1 and 2 ranks; 0.1 s (~1200 steps) after a
+// start-up of 0.02 s. The same bound as in 2-D (ten times the still tank's noise, or the outer
+// tolerance's h / Δt), and every fluid's mass to round-off (4096 cells of summands, 1e-12). Measured
+// (1 / 2 ranks): the cube's fastest particle 5.8e-8 / 4.7e-8 m/s against bounds of 2.0e-5 / 2.3e-5
+// (the still tank's noise 2.0e-6 / 2.3e-6 m/s), displacement 3e-11 / 5e-11 m, the masses to 2.5e-14.
+std::string cubeTank(const std::string& solids, const std::string& regions)
+{
+  return R"(
+cfdmpm:
+  domain: {dimension: 3, lower: [0.0, 0.0, 0.0], upper: [0.2, 0.2, 0.2], cells: [16, 16, 16], patch_cells: [8, 8, 8], gravity: [0.0, -9.81, 0.0]}
+  materials:
+)" + solids + R"(
+    water:
+      kind: fluid
+      equation_of_state: {type: linear_water, bulk_modulus: 2.15e9, reference_density: 1000.0, reference_pressure: 101325.0, reference_temperature: 293.15, thermal_expansion: 0.0}
+      viscosity: 1.0e-3
+      specific_heat: 4180.0
+    air:
+      kind: fluid
+      equation_of_state: {type: ideal_gas, gas_constant: 287.0, gamma: 1.4}
+      viscosity: 1.8e-5
+  initial_state: {background_material: air, temperature: 293.15, pressure: 101325.0, hydrostatic: true}
+  regions:
+    level: {material: water, shape: half_plane, point: [0.0, 0.15, 0.0], normal: [0.0, 1.0, 0.0]}
+)" + regions + R"(
+  time: {end_time: 1.0, cfl: 0.25, dt_initial: 1.0e-5}
+  output: {directory: unused, interval: 0.0}
+)";
+}
+
+TEST(CoupledStep, ThreeDNeutralCubeStaysPutAndKeepsItsWater)
+{
+  const double end = 0.1, start_up = 0.02;
+  CoupledRun<3> still(sceneFromYaml(cubeTank("", "")), world());
+  double noise = 0;
+  still.runUntil(end, [&] {
+    if (still.time > start_up) noise = std::max({noise, still.maxFluidSpeed(0), still.maxFluidSpeed(1)});
+  });
+  // Neutral at the cube's centre, 0.075 m under the surface (the air above adds ~0.6 Pa).
+  const double neutral = 1000.0 + 1000.0 * 9.81 * 0.075 / 2.15e6;
+  CoupledRun<3> run(sceneFromYaml(cubeTank(withDensity(kElasticBlock, neutral),
+                                           "    b: {material: block, shape: box, lower: [0.075, 0.05, 0.075], upper: [0.125, 0.1, 0.125]}")),
+                    world());
+  const auto start = run.positions();
+  const double mass0[2] = {run.fluidMass(1), run.fluidMass(2)};  // water, air (the block is material 0)
+  double fastest = 0;
+  run.runUntil(end, [&] {
+    if (run.time > start_up) fastest = std::max(fastest, run.maxParticleSpeed(0));
+  });
+  double moved = 0;
+  for (const auto& [id, x] : run.positions())
+    moved = std::max(moved, std::sqrt(std::pow(x[0] - start.at(id)[0], 2) + std::pow(x[1] - start.at(id)[1], 2) +
+                                      std::pow(x[2] - start.at(id)[2], 2)));
+  moved = globalMax(*world(), moved);
+  const double tolerance_speed = IceSettings::fromScene(run.scene).outer_tolerance * (0.2 / 16) / run.dt_previous;
+  const double bound = std::max(10 * noise, tolerance_speed);
+  const double water_change = run.fluidMass(1) / mass0[0] - 1, air_change = run.fluidMass(2) / mass0[1] - 1;  // collective
+  if (world()->getRank() == 0)
+    std::printf("3-D: still-tank noise %.3e m/s, tolerance h / dt %.3e m/s; cube: fastest particle after start-up %.3e "
+                "m/s, largest displacement %.3e m in %lld steps; water mass change %.1e, air %.1e\n",
+                noise, tolerance_speed, fastest, moved, run.steps, water_change, air_change);
+  EXPECT_GT(run.steps, 100);  // the run took steps of its own (Δt from the particles' wave speed)
+  EXPECT_LE(fastest, bound);
+  EXPECT_LE(moved, bound * end);
+  EXPECT_LT(std::abs(water_change), 1e-12);
+  EXPECT_LT(std::abs(air_change), 1e-12);
+}
+
 // (b) A sand block resting on the floor under water: the water's pressure is not the skeleton's, so
 // the block's skeleton carries its buoyant weight, (ρs − ρw) g per volume, and nothing more, and the
 // block stays at rest. The reference is the same block dry (the particle step alone) under the

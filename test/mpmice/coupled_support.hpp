@@ -10,6 +10,19 @@
 
 namespace cfdmpm::test {
 
+/// The tanks' fluids as YAML materials: water (compressible, K = 2.15e9 Pa) and air.
+inline const char* kTankWater = R"(    water:
+      kind: fluid
+      equation_of_state: {type: linear_water, bulk_modulus: 2.15e9, reference_density: 1000.0, reference_pressure: 101325.0, reference_temperature: 293.15, thermal_expansion: 0.0}
+      viscosity: 1.0e-3
+      specific_heat: 4180.0
+)";
+inline const char* kTankAir = R"(    air:
+      kind: fluid
+      equation_of_state: {type: ideal_gas, gas_constant: 287.0, gamma: 1.4}
+      viscosity: 1.8e-5
+)";
+
 /// A tank of water (and air above when `water_top` < the tank's top) on nx x ny cells with
 /// `solids` (YAML of the solid materials) and `regions` (YAML of their regions), closed by no-slip
 /// walls. `extra` is appended inside `cfdmpm:` (e.g. an `mpm:` or `ice:` section).
@@ -24,19 +37,8 @@ cfdmpm:
                      "], cells: [" + std::to_string(nx) + ", " + std::to_string(ny) + "], patch_cells: [10, 10], gravity: [0.0, " +
                      std::to_string(gravity) + R"(]}
   materials:
-)" + solids + R"(
-    water:
-      kind: fluid
-      equation_of_state: {type: linear_water, bulk_modulus: 2.15e9, reference_density: 1000.0, reference_pressure: 101325.0, reference_temperature: 293.15, thermal_expansion: 0.0}
-      viscosity: 1.0e-3
-      specific_heat: 4180.0
-)";
-  if (air)
-    text += R"(    air:
-      kind: fluid
-      equation_of_state: {type: ideal_gas, gas_constant: 287.0, gamma: 1.4}
-      viscosity: 1.8e-5
-)";
+)" + solids + "\n" + kTankWater;
+  if (air) text += kTankAir;
   text += std::string("  initial_state: {background_material: ") + (air ? "air" : "water") +
           ", temperature: 293.15, pressure: 101325.0}\n  regions:\n";
   if (air)

@@ -84,17 +84,7 @@ std::string cubeTank(const std::string& solids, const std::string& regions)
 cfdmpm:
   domain: {dimension: 3, lower: [0.0, 0.0, 0.0], upper: [0.2, 0.2, 0.2], cells: [16, 16, 16], patch_cells: [8, 8, 8], gravity: [0.0, -9.81, 0.0]}
   materials:
-)" + solids + R"(
-    water:
-      kind: fluid
-      equation_of_state: {type: linear_water, bulk_modulus: 2.15e9, reference_density: 1000.0, reference_pressure: 101325.0, reference_temperature: 293.15, thermal_expansion: 0.0}
-      viscosity: 1.0e-3
-      specific_heat: 4180.0
-    air:
-      kind: fluid
-      equation_of_state: {type: ideal_gas, gas_constant: 287.0, gamma: 1.4}
-      viscosity: 1.8e-5
-  initial_state: {background_material: air, temperature: 293.15, pressure: 101325.0, hydrostatic: true}
+)" + solids + "\n" + kTankWater + kTankAir + R"(  initial_state: {background_material: air, temperature: 293.15, pressure: 101325.0, hydrostatic: true}
   regions:
     level: {material: water, shape: half_plane, point: [0.0, 0.15, 0.0], normal: [0.0, 1.0, 0.0]}
 )" + regions + R"(

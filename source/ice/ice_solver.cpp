@@ -828,7 +828,7 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
   const double volume = layout_->grid().cellVolume();
   // No fluid with a finite compressibility: every cell's volume residual as it is.
   const double stiffest = stiffest_compressibility_ > 0 ? stiffest_compressibility_ : INFINITY;
-  const double stiffest_density = stiffest_compressibility_ > 0 ? stiffest_density_ : 0.0;
+  const double stiffest_density = stiffest_density_;  // 0 without such a fluid: no density factor
   const auto mass_density = state.density.view();
   double area[3], dt_per_h[3];
   for (int d = 0; d < Dim; ++d) {

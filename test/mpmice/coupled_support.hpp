@@ -196,6 +196,17 @@ struct CoupledRun {
     return out;
   }
 
+  /// Largest distance of any particle from its position in `start` (from positions(); collective).
+  double largestDisplacement(const std::map<long long, std::array<double, 3>>& start)
+  {
+    double moved = 0;
+    for (const auto& [id, x] : positions()) {
+      const auto& x0 = start.at(id);
+      moved = std::max(moved, std::hypot(x[0] - x0[0], x[1] - x0[1], x[2] - x0[2]));
+    }
+    return globalMax(*layout->comm(), moved);
+  }
+
   /// Largest speed of fluid material m over owned cells where it fills more than `share` (collective).
   double maxFluidSpeed(int m, double share = 1e-3)
   {

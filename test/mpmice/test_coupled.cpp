@@ -58,9 +58,7 @@ TEST(CoupledStep, NeutrallyBuoyantBlockStaysPut)
     peak = std::max(peak, speed);
     if (run.time > start_up) fastest = std::max(fastest, speed);
   });
-  double moved = 0;
-  for (const auto& [id, x] : run.positions()) moved = std::max(moved, std::hypot(x[0] - start.at(id)[0], x[1] - start.at(id)[1]));
-  moved = globalMax(*world(), moved);
+  const double moved = run.largestDisplacement(start);
   if (world()->getRank() == 0)
     std::printf("still-tank noise %.3e m/s, tolerance h / dt %.3e m/s; block: fastest particle after start-up %.3e "
                 "m/s (peak %.3e), largest displacement %.3e m in %lld steps\n",
@@ -112,11 +110,7 @@ TEST(CoupledStep, ThreeDNeutralCubeStaysPutAndKeepsItsWater)
   run.runUntil(end, [&] {
     if (run.time > start_up) fastest = std::max(fastest, run.maxParticleSpeed(0));
   });
-  double moved = 0;
-  for (const auto& [id, x] : run.positions())
-    moved = std::max(moved, std::sqrt(std::pow(x[0] - start.at(id)[0], 2) + std::pow(x[1] - start.at(id)[1], 2) +
-                                      std::pow(x[2] - start.at(id)[2], 2)));
-  moved = globalMax(*world(), moved);
+  const double moved = run.largestDisplacement(start);
   const double tolerance_speed = IceSettings::fromScene(run.scene).outer_tolerance * (0.2 / 16) / run.dt_previous;
   const double bound = std::max(10 * noise, tolerance_speed);
   const double water_change = run.fluidMass(1) / mass0[0] - 1, air_change = run.fluidMass(2) / mass0[1] - 1;  // collective

@@ -854,7 +854,11 @@ InitialStateSpec readInitialState(ParameterList& list, const std::vector<Materia
   }
   if (std::find(fluids.begin(), fluids.end(), initial.background_material) == fluids.end()) {
     throw inputError(path + ".background_material", initial.background_material,
-                     "must name a fluid material; fluids: " + (fluids.empty() ? std::string("none") : join(fluids)));
+                     "must name a fluid material; fluids: " +
+                         (fluids.empty() ? std::string("none (every scene has a background fluid; a dry scene of solids "
+                                                       "alone declares one, e.g. air, and sets ice.enabled: false, as "
+                                                       "input/granular-column.yaml does)")
+                                         : join(fluids)));
   }
   return initial;
 }

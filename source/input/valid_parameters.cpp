@@ -251,7 +251,9 @@ void defineIce(ParameterList& ice)
          "false: the fluids stay as they are, an inert background, and the solids run alone (a dry scene).",
          ParameterRule{});
   define(ice, "isothermal", true,
-         "false: solve the energy equation (pressure work, conduction, heat exchange, advection of T).",
+         "false: solve the energy equation (pressure work, conduction, heat exchange, advection of T). Fluids "
+         "only: a scene with a solid material is refused with false (the coupled step does not carry the "
+         "solids' temperature yet).",
          ParameterRule{});
   define(ice, "heat_exchange_coefficient", 0.0, "Heat exchange H between every pair of materials.",
          atLeast(0, "W/(m^3 K)"));

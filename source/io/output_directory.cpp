@@ -4,6 +4,9 @@
 #include "io/collective.hpp"
 
 #include <algorithm>
+#include <cerrno>
+#include <cstdlib>
+#include <system_error>
 #include <filesystem>
 #include <stdexcept>
 #include <utility>
@@ -15,7 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr const char* kKey = "output.directory";
+constexpr const char* kKey = "cfdmpm.output.directory";
 
 bool endsWith(const std::string& text, const std::string& suffix)
 {
@@ -60,6 +63,14 @@ void checkOnThisRank(const std::string& directory, bool overwrite)
     path = path.parent_path();
   if (!fs::is_directory(fs::status(path, error)) || ::access(path.c_str(), W_OK | X_OK) != 0)
     throw directoryError(directory, "cannot be created: '" + path.string() + "' is not a writable directory");
+  // Permission bits do not say everything (root passes access() everywhere, and /proc or a
+  // read-only mount refuse new entries whatever the bits): create a scratch directory there and
+  // remove it, so that what this check passes the run can create.
+  std::string probe = (path / ".cfdmpm-check-XXXXXX").string();
+  if (::mkdtemp(probe.data()) == nullptr)
+    throw directoryError(directory, "cannot be created: no new entry can be made in '" + path.string() +
+                                        "': " + std::generic_category().message(errno));
+  fs::remove(probe, error);
 }
 
 void prepareOnThisRank(const std::string& directory, bool overwrite)

@@ -13,7 +13,7 @@ namespace cfdmpm {
 ///  - missing: created, with its parents;
 ///  - exists and empty: used as it is;
 ///  - exists, not empty, overwrite false: throws InputError
-///    "output.directory: '<path>' exists and is not empty; choose another directory or set
+///    "cfdmpm.output.directory: '<path>' exists and is not empty; choose another directory or set
 ///    output.overwrite: true", and nothing is changed;
 ///  - exists, not empty, overwrite true: the files cfdmpm writes there (see isOutputFile) are
 ///    removed, everything else is left alone.

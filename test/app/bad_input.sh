@@ -153,6 +153,12 @@ RANKS=2 expect_both one_patch_two_ranks "$(good | sed 's/patch_cells: \[5, 5\]/p
 mkdir -p "$work/out" && touch "$work/out/earlier-run.csv"
 KEEP_OUT=earlier-run.csv expect_both output_directory_not_empty "$(good)" "output.directory" "not empty" "overwrite"
 rm -rf "$work/out"
+# A directory that permission bits allow but that cannot be made (/proc takes no new entries, even
+# for root): --check must refuse it as the run does, not pass a scene the run then refuses.
+if [ -d /proc/self ]; then
+  expect_both output_directory_uncreatable "$(good | sed 's#directory: [^,]*,#directory: /proc/cfdmpm_out,#')" \
+    "cfdmpm.output.directory" "/proc/cfdmpm_out" "cannot be created"
+fi
 
 "$CFDMPM" "$work/does-not-exist.yaml" > /dev/null 2> "$work/missing.err"
 code=$?

@@ -48,7 +48,7 @@ TEST(OutputDirectory, NonEmptyDirectoryIsRefusedWithoutOverwriteAndLeftAlone)
     message = e.what();
   }
   // Every rank gets the same InputError.
-  EXPECT_EQ(message, "output.directory: '" + directory +
+  EXPECT_EQ(message, "cfdmpm.output.directory: '" + directory +
                          "' exists and is not empty; choose another directory or set "
                          "output.overwrite: true");
   if (rank() == 0) {

@@ -222,6 +222,17 @@ struct CoupledRun {
     return globalMax(*layout->comm(), fastest);
   }
 
+  /// Kinetic energy (per metre in 2-D) of fluid material m over owned cells (collective).
+  double fluidKineticEnergy(int m)
+  {
+    const auto rho = state.density.view();
+    const auto u = state.velocity.view();
+    double sum = 0;
+    for (LocalOrdinal c = 0; c < state.density.ownedCount(); ++c)
+      for (int d = 0; d < Dim; ++d) sum += 0.5 * rho(c, m) * u(c, m * Dim + d) * u(c, m * Dim + d);
+    return globalSum(*layout->comm(), sum * layout->grid().cellVolume());
+  }
+
   /// Total mass (per metre in 2-D) and momentum component d of fluid material m (collective).
   double fluidMass(int m)
   {

@@ -689,11 +689,6 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
   const auto roles = roles_;
   const auto closed = closed_;
   auto leaves = fluid_outflow_share_;
-  // With the solids' volumes from their particles (mpm.solid_volume: particles) the fluids keep the
-  // donor's layer as their room (below): with the face's cover, the resting sand block of
-  // CoupledStep.ParticleVolumesKeepTheBlocksBuoyantWeight carried 1.078 of its buoyant weight at
-  // its base (1.03 allowed; 0.998 in the default mode), which is not understood yet.
-  const bool face_cover = !solid_volume_predictor_;
   for (int d = 0; d < Dim; ++d) {
     auto out = fluid_face_fraction_.direction(d).view();
     const auto share = solid_face_share_.direction(d).view();
@@ -707,11 +702,10 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
             leaves(c, 2 * d) = 1.0;
             return;
           }
-          double fluid[2] = {0, 0}, rigid[2] = {0, 0}, deformable[2] = {0, 0};
+          double fluid[2] = {0, 0}, solid[2] = {0, 0};
           for (int m = 0; m < n; ++m) {
             if (roles.lagrangian[m] || roles.rigid[m]) {
-              for (int side = 0; side < 2; ++side)
-                (roles.rigid[m] ? rigid : deformable)[side] += Kokkos::Experimental::fmin(1.0, share(c, 2 * m + side));
+              for (int side = 0; side < 2; ++side) solid[side] += Kokkos::Experimental::fmin(1.0, share(c, 2 * m + side));
               out(c, 2 * m) = out(c, 2 * m + 1) = 0.0;
               continue;
             }
@@ -730,31 +724,9 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
           // the water left faster than the front by that factor, and the front cell's pressure
           // peak drove the water ahead). A donor whose fluids' profiles hold less than
           // kFillMinimum of the face keeps its profile (a nearly dry cell does not fill a face).
-          // The room is what the face itself leaves open (doc/mpmice.md, "the fluids' room on a
-          // face"). A deformable solid covers the face only where it lies on both sides of it (in
-          // both layers, MpmSolver::particlesToCells); a surface inside one layer has not reached
-          // the face, which is still all fluid there. Where it crosses the face, its cover lies
-          // between two limits: a surface across the face covers it by the mean of the two
-          // layers' shares, one along the face just beyond it fills one layer and covers the face
-          // whole; the fuller layer's share f weighs the second as f^8 (half at f = 0.92).
-          // Taken from the donor's layer alone, the room had two faults that a block falling
-          // through air showed: beneath it, the air between its bottom and the face below left
-          // through (1 - share) of that face, ever faster as the bottom neared the face; above
-          // it, once its top entered the layer over the face below the top, the air crossed that
-          // face into the cells the block filled and was trapped there (a donor the block fills on
-          // its side gave nothing); at 10 mm cells the air reached 47-315 m/s, with no step
-          // refused. A rigid body keeps the donor's layer (it closes faces in faceVelocities too).
-          double covered = 0;
-          if (deformable[0] > kSolidPresent && deformable[1] > kSolidPresent) {
-            const double across = 0.5 * (deformable[0] + deformable[1]);
-            const double fuller = Kokkos::Experimental::fmin(1.0, Kokkos::Experimental::fmax(deformable[0], deformable[1]));
-            const double along = fuller * fuller, along4 = along * along;
-            covered = across + (fuller - across) * along4 * along4;
-          }
           double keep[2];
           for (int side = 0; side < 2; ++side) {
-            const double closed = rigid[side] + (face_cover ? covered : deformable[side]);
-            const double room = closed < 1.0 ? 1.0 - closed : 0.0;
+            const double room = solid[side] < 1.0 ? 1.0 - solid[side] : 0.0;
             const LocalOrdinal donor = side == 0 ? l : c;
             double donor_solid = 0;
             if (donor >= 0)

@@ -266,15 +266,14 @@ TEST(CoupledStep, LightBodyRisesWithTheAddedMassOfPotentialFlow)
 // below 1e-3 of its weight (buoyancy ρ_air/ρ_s = 4e-4; drag at 0.6 m/s ~4e-4 g), so its mean
 // velocity is −g t to 1 % (bound) throughout. The air moves as the block displaces it: in
 // potential flow its kinetic energy is ½ C_a ρ_air a² V² with C_a = 1.19 for a square, and the
-// tank, five blocks wide, raises that by a factor of order one (measured: 2.0-2.55 times). Bound:
-// ten times potential flow's, up to 0.045 s. That window holds the crossing that failed: after
-// 8.75 mm of fall the block's top enters the layer over the face below it, where the fluids' room
-// taken from the donor's layer let the air cross into the block's cells and trapped it there;
-// from 0.0425 s the air had 1e5 times the bound (18-38 J/m) and stirred the pool below, with no step
-// refused (doc/mpmice.md, "the fluids' room on a face"). It ends before the bottom reaches the face
-// below it (10 mm, 0.0452 s): there the last trace of air under the block is still closed in by
-// the cover that shuts the face, and the air's kinetic energy rises for a few steps to 12-900 times
-// potential flow's, depending on the scene's details (doc/mpmice.md, "Not yet").
+// tank, five blocks wide, raises that by a factor of order one (measured before any crossing:
+// 2.0-2.55 times). Bound: ten times potential flow's, up to 0.045 s, a window that holds the first
+// crossing (after 8.75 mm of fall the block's top enters the layer over the face below it) and
+// ends before the bottom reaches the face below it (10 mm, 0.0452 s).
+// This case FAILS today and runs in the stability label only (test/mpmice/CMakeLists.txt): with the
+// fluids' room on a face taken from the donor's layer alone, the air crosses into the block's cells
+// at the first crossing and is trapped there; from 0.0425 s the air holds 1.9e5 times the bound and
+// the block falls 20 % slower than g t (doc/mpmice.md, "Not yet", 2026-12-06, with the rule tried).
 TEST(CoupledStep, BlockFallingThroughAirKeepsTheAirToItsOwnFlow)
 {
   const double a = 0.04, rho_air = 101325.0 / (287.0 * 293.15), g = 9.81, air_window = 0.045;

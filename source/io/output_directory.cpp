@@ -6,9 +6,9 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdlib>
-#include <system_error>
 #include <filesystem>
 #include <stdexcept>
+#include <system_error>
 #include <utility>
 #include <unistd.h>
 #include <vector>
@@ -67,9 +67,11 @@ void checkOnThisRank(const std::string& directory, bool overwrite)
   // read-only mount refuse new entries whatever the bits): create a scratch directory there and
   // remove it, so that what this check passes the run can create.
   std::string probe = (path / ".cfdmpm-check-XXXXXX").string();
-  if (::mkdtemp(probe.data()) == nullptr)
+  if (::mkdtemp(probe.data()) == nullptr) {
+    const int reason = errno;  // before anything else can set it
     throw directoryError(directory, "cannot be created: no new entry can be made in '" + path.string() +
-                                        "': " + std::generic_category().message(errno));
+                                        "': " + std::generic_category().message(reason));
+  }
   fs::remove(probe, error);
 }
 

@@ -270,10 +270,12 @@ TEST(CoupledStep, LightBodyRisesWithTheAddedMassOfPotentialFlow)
 // 2.0-2.55 times). Bound: ten times potential flow's, up to 0.045 s, a window that holds the first
 // crossing (after 8.75 mm of fall the block's top enters the layer over the face below it) and
 // ends before the bottom reaches the face below it (10 mm, 0.0452 s).
-// This case FAILS today and runs in the stability label only (test/mpmice/CMakeLists.txt): with the
-// fluids' room on a face taken from the donor's layer alone, the air crosses into the block's cells
-// at the first crossing and is trapped there; from 0.0425 s the air holds 1.9e5 times the bound and
-// the block falls 20 % slower than g t (doc/mpmice.md, "Not yet", 2026-12-06, with the rule tried).
+// With the fluids' room on a face taken from the donor's layer alone (before 2026-12-06) the air
+// crossed into the block's cells at that crossing and was trapped there: from 0.0425 s the air held
+// 1.9e5 times the bound and the block fell 20 % slower than g t (doc/mpmice.md, "the fluids' room on
+// a face"). At the bottom's crossing the last trace of air under the block is still closed in by the
+// cover that shuts the face, and the air's kinetic energy rises for a few steps to 12-900 times
+// potential flow's, depending on the scene's details.
 TEST(CoupledStep, BlockFallingThroughAirKeepsTheAirToItsOwnFlow)
 {
   const double a = 0.04, rho_air = 101325.0 / (287.0 * 293.15), g = 9.81, air_window = 0.045;

@@ -273,9 +273,9 @@ TEST(CoupledStep, LightBodyRisesWithTheAddedMassOfPotentialFlow)
 // With the fluids' room on a face taken from the donor's layer alone (before 2026-12-06) the air
 // crossed into the block's cells at that crossing and was trapped there: from 0.0425 s the air held
 // 1.9e5 times the bound and the block fell 20 % slower than g t (doc/mpmice.md, "the fluids' room on
-// a face"). At the bottom's crossing the last trace of air under the block is still closed in by the
-// cover that shuts the face, and the air's kinetic energy rises for a few steps to 12-900 times
-// potential flow's, depending on the scene's details.
+// a face"). The window stops there because the crossings after it still stir the air: run on to
+// 0.08 s this tank's air reaches 1220 and 440 times potential flow's at the second and third
+// crossings (doc/mpmice.md, "What remains at the falling block").
 TEST(CoupledStep, BlockFallingThroughAirKeepsTheAirToItsOwnFlow)
 {
   const double a = 0.04, rho_air = 101325.0 / (287.0 * 293.15), g = 9.81, air_window = 0.045;

@@ -1534,6 +1534,7 @@ void IceSolver<Dim>::pressurePhase(CellState<Dim>& state, double dt, IceStepRepo
                 << solve.relative_residual << " after " << solve.iterations << " CG iterations, tolerance "
                 << solve.tolerance;
         if (!solve.failure.empty()) message << " (" << solve.failure << ")";
+        message << "; the largest volume imbalance it had to correct is at " << largestResidualCell(state);
         if (settings_.solver_tolerance_given && settings_.solver_tolerance < 1e-13)
           message << "; cfdmpm.ice.solver_tolerance below ~1e-13 can stall at round-off";
         throw StepFailure(message.str());
@@ -1685,6 +1686,54 @@ bool IceSolver<Dim>::followCompressibility(const CellState<Dim>& state)
         if (!closed(c)) sum_kappa(c, 0) = slope(c);
       });
   return true;
+}
+
+template <int Dim>
+std::string IceSolver<Dim>::largestResidualCell(const CellState<Dim>& state) const
+{
+  const auto rhs = rhs_.view();
+  const auto weight = outer_weight_.view();
+  const auto ijk = layout_->cellIndex();
+  const long long nx = layout_->grid().cells()[0], ny = layout_->grid().cells()[1];
+  // A value that is not finite counts as the largest (as in the outer test).
+  using Location = Kokkos::MaxLoc<double, LocalOrdinal>;
+  typename Location::value_type local;
+  Kokkos::parallel_reduce(
+      "ice::largestResidualCell", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+      KOKKOS_LAMBDA(const LocalOrdinal c, typename Location::value_type& best) {
+        const double a = Kokkos::Experimental::isfinite(rhs(c, 0)) ? weight(c, 0) * Kokkos::Experimental::fabs(rhs(c, 0)) : INFINITY;
+        if (a > best.val) best.val = a, best.loc = c;
+      },
+      Location(local));
+  double global_value = 0;
+  Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_MAX, local.val, Teuchos::outArg(global_value));
+  // The lowest global cell id among the ranks that hold the largest value.
+  long long id = LLONG_MAX;
+  if (layout_->ownedCells() > 0 && local.val == global_value) {
+    const auto at = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), Kokkos::subview(ijk, local.loc, Kokkos::ALL));
+    id = at(0) + nx * (at(1) + (Dim == 3 ? ny * at(2) : 0));
+  }
+  long long global_id = LLONG_MAX;
+  Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_MIN, id, Teuchos::outArg(global_id));
+  // The volume fractions travel from the rank that holds the cell (the others send zeros).
+  const int n = materials_;
+  std::vector<double> fractions(n, 0.0), global_fractions(n, 0.0);
+  if (id == global_id && id != LLONG_MAX) {
+    const auto theta = Kokkos::create_mirror_view_and_copy(
+        Kokkos::HostSpace(), Kokkos::subview(state.volume_fraction.view(), local.loc, Kokkos::ALL));
+    for (int m = 0; m < n; ++m) fractions[m] = theta(m);
+  }
+  Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_SUM, n, fractions.data(), global_fractions.data());
+  std::ostringstream text;
+  if (global_id == LLONG_MAX) return "no cell (the grid has none)";
+  const auto cell = layout_->grid().cellIndex(global_id);
+  text << "cell (" << cell[0] << ", " << cell[1];
+  if (Dim == 3) text << ", " << cell[2];
+  text << "), " << std::scientific << std::setprecision(3) << global_value / layout_->grid().cellVolume()
+       << " of its volume (volume fractions:";
+  for (int m = 0; m < n; ++m) text << " " << names_[m] << " " << global_fractions[m];
+  text << ")";
+  return text.str();
 }
 
 // [10] Advection of mass, velocity and specific volume of the fluids by the corrected face

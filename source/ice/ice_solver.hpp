@@ -232,6 +232,9 @@ class IceSolver {
  private:
   void faceVelocities(const CellState<Dim>& state, double dt);
   double pressureRightHandSide(CellState<Dim>& state, double dt, bool after_solve);
+  /// "cell (i, j): ..." for the cell whose weighted volume residual (the outer test's) is the
+  /// largest on any rank, with its materials' volume fractions; the same text on every rank.
+  std::string largestResidualCell(const CellState<Dim>& state) const;
   void applyPressureCorrection(CellState<Dim>& state, double dt);
   // Σ_m θ_m κ_m s'(κ_m Σδp) into mixture_compressibility_ where that is more than
   // kCompressibilityChange below it somewhere; returns whether it wrote (then reassemble).

@@ -1,12 +1,15 @@
 // The ICE solver on whole scenes: still water, an acoustic pulse at large time steps, the same dam
 // break on 1 and 2 ranks.
+#include "common/error.hpp"
 #include "ice/eos.hpp"
 #include "ice_scene_support.hpp"
 
 #include <gtest/gtest.h>
+#include <Teuchos_CommHelpers.hpp>
 #include <Tpetra_Core.hpp>
 
 #include <cmath>
+#include <iostream>
 #include <string>
 #include <vector>
 
@@ -302,6 +305,38 @@ cfdmpm:
 }
 
 }  // namespace
+
+TEST(IceScenes, PressureSolveThatFailsNamesTheCellItCouldNotBalance)
+{
+  // A linear solve allowed one CG iteration to a relative residual of 1e-12 cannot converge on the
+  // dam break's first step (one iteration leaves ~0.36 of the residual; at 200 x 80 cells, since
+  // on a grid of 50 x 20 one rank's solve converged in its one iteration). The step stops with a
+  // message that names the cell with the largest volume imbalance the correction had to make
+  // (weighed as the outer test weighs it) and its materials, the same on every rank; before, it
+  // named only the residual, and a light disk's run that blew up stopped with nothing to look at.
+  const Scene scene = damBreakScene(200, 80, 20, "{solver_tolerance: 1.0e-12, linear_solver: {maximum iterations: 1}}");
+  IceRun<2> run(scene, world());
+  std::string message;
+  try {
+    run.runUntil(1e-4, 1e-4);
+  } catch (const StepFailure& failure) {
+    message = failure.what();
+  }
+  std::cout << message << "\n";
+  EXPECT_NE(message.find("linear solve did not converge"), std::string::npos) << message;
+  const std::size_t at = message.find("the largest volume imbalance it had to correct is at cell (");
+  ASSERT_NE(at, std::string::npos) << message;
+  EXPECT_NE(message.find("(volume fractions: water ", at), std::string::npos) << message;
+  // Every rank names the same cell, with the same numbers: rank 0's text, sent to all.
+  const std::string named = message.substr(at);
+  const auto comm = world();
+  int size = static_cast<int>(named.size());
+  Teuchos::broadcast(*comm, 0, &size);
+  std::vector<char> root(named.begin(), named.end());
+  root.resize(size);
+  Teuchos::broadcast(*comm, 0, size, root.data());
+  EXPECT_EQ(std::string(root.begin(), root.end()), named);
+}
 
 TEST(IceScenes, HeatConductsLikeTheDiffusionEquation)
 {

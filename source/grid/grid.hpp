@@ -74,6 +74,14 @@ class Grid {
   long long nodeId(const std::array<long long, 3>& ijk) const { return linear(ijk, nodes_); }
   std::array<long long, 3> cellIndex(long long id) const { return unlinear(id, cells_); }
   std::array<long long, 3> nodeIndex(long long id) const { return unlinear(id, nodes_); }
+  /// "cell (i, j)" or "cell (i, j, k)" for the cell with global index id, as messages name it.
+  std::string cellName(long long id) const
+  {
+    const auto ijk = cellIndex(id);
+    std::string name = "cell (" + std::to_string(ijk[0]) + ", " + std::to_string(ijk[1]);
+    if (Dim == 3) name += ", " + std::to_string(ijk[2]);
+    return name + ")";
+  }
 
   /// The cell that owns a node: the cell whose lower corner it is, clamped at the upper faces.
   std::array<long long, 3> ownerCellOfNode(const std::array<long long, 3>& node) const

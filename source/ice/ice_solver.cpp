@@ -1693,8 +1693,6 @@ std::string IceSolver<Dim>::largestResidualCell(const CellState<Dim>& state) con
 {
   const auto rhs = rhs_.view();
   const auto weight = outer_weight_.view();
-  const auto ijk = layout_->cellIndex();
-  const long long nx = layout_->grid().cells()[0], ny = layout_->grid().cells()[1];
   // A value that is not finite counts as the largest (as in the outer test).
   using Location = Kokkos::MaxLoc<double, LocalOrdinal>;
   typename Location::value_type local;
@@ -1709,10 +1707,7 @@ std::string IceSolver<Dim>::largestResidualCell(const CellState<Dim>& state) con
   Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_MAX, local.val, Teuchos::outArg(global_value));
   // The lowest global cell id among the ranks that hold the largest value.
   long long id = LLONG_MAX;
-  if (layout_->ownedCells() > 0 && local.val == global_value) {
-    const auto at = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), Kokkos::subview(ijk, local.loc, Kokkos::ALL));
-    id = at(0) + nx * (at(1) + (Dim == 3 ? ny * at(2) : 0));
-  }
+  if (layout_->ownedCells() > 0 && local.val == global_value) id = layout_->ownedCellMap()->getGlobalElement(local.loc);
   long long global_id = LLONG_MAX;
   Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_MIN, id, Teuchos::outArg(global_id));
   // The volume fractions travel from the rank that holds the cell (the others send zeros).
@@ -1724,12 +1719,9 @@ std::string IceSolver<Dim>::largestResidualCell(const CellState<Dim>& state) con
     for (int m = 0; m < n; ++m) fractions[m] = theta(m);
   }
   Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_SUM, n, fractions.data(), global_fractions.data());
-  std::ostringstream text;
   if (global_id == LLONG_MAX) return "no cell (the grid has none)";
-  const auto cell = layout_->grid().cellIndex(global_id);
-  text << "cell (" << cell[0] << ", " << cell[1];
-  if (Dim == 3) text << ", " << cell[2];
-  text << "), " << std::scientific << std::setprecision(3) << global_value / layout_->grid().cellVolume()
+  std::ostringstream text;
+  text << layout_->grid().cellName(global_id) << ", " << std::scientific << std::setprecision(3) << global_value / layout_->grid().cellVolume()
        << " of its volume (volume fractions:";
   for (int m = 0; m < n; ++m) text << " " << names_[m] << " " << global_fractions[m];
   text << ")";
@@ -1751,11 +1743,9 @@ void IceSolver<Dim>::advectionPhase(CellState<Dim>& state, double dt, IceStepRep
   report.max_outflux_fraction = advected.max_outflux_fraction;
   if (!advected.ok) {
     // The same on every rank: the status is reduced over all of them.
-    const auto ijk = layout_->grid().cellIndex(advected.cell);
     std::ostringstream message;
-    message << "ice: advection: the outflux of " << names_[advected.material] << " from cell (" << ijk[0] << ", "
-            << ijk[1] << (Dim == 3 ? ", " + std::to_string(ijk[2]) : std::string()) << ") is "
-            << advected.max_outflux_fraction << " of its volume in one step (at most 1)";
+    message << "ice: advection: the outflux of " << names_[advected.material] << " from "
+            << layout_->grid().cellName(advected.cell) << " is " << advected.max_outflux_fraction << " of its volume in one step (at most 1)";
     throw StepFailure(message.str());
   }
 

@@ -73,17 +73,6 @@ template <int Dim>
 MpmIceStep<Dim>::~MpmIceStep() = default;
 
 template <int Dim>
-std::string MpmIceStep<Dim>::cellName(long long global_id) const
-{
-  const auto cell = layout_->grid().cellIndex(global_id);
-  std::ostringstream name;
-  name << "cell (" << cell[0] << ", " << cell[1];
-  if (Dim == 3) name << ", " << cell[2];
-  name << ")";
-  return name.str();
-}
-
-template <int Dim>
 CoupledStepReport MpmIceStep<Dim>::step(CellState<Dim>& state, double dt)
 {
   CoupledStepReport report;
@@ -122,7 +111,7 @@ CoupledStepReport MpmIceStep<Dim>::step(CellState<Dim>& state, double dt)
       if (report.ice.equilibration_failures > 0) {
         std::ostringstream message;
         message << "coupled step: the equilibration pressure did not converge in " << report.ice.equilibration_failures
-                << " cell(s), the first at " << cellName(report.ice.first_failed_equilibration)
+                << " cell(s), the first at " << layout_->grid().cellName(report.ice.first_failed_equilibration)
                 << "; its materials' densities admit no common pressure (a material compressed beyond what its "
                    "equation of state represents; reduce the time step or check the materials' parameters)";
         throw StepFailure(message.str());
@@ -139,7 +128,7 @@ CoupledStepReport MpmIceStep<Dim>::step(CellState<Dim>& state, double dt)
         std::ostringstream message;
         message << "coupled step: the pressure equation's right-hand side is not finite";
         if (report.ice.first_nonfinite_pressure_cell >= 0)
-          message << " at " << cellName(report.ice.first_nonfinite_pressure_cell) << " (the lowest such cell)";
+          message << " at " << layout_->grid().cellName(report.ice.first_nonfinite_pressure_cell) << " (the lowest such cell)";
         message << ", while every cell's density, volume fraction, specific volume and velocity is: a face "
                    "velocity or a solid's volume change from its particles there is not (reduce the time step)";
         throw StepFailure(message.str());
@@ -155,7 +144,7 @@ CoupledStepReport MpmIceStep<Dim>::step(CellState<Dim>& state, double dt)
       const long long cell = report.ice.first_failed_cell;
       std::ostringstream message;
       message << "coupled step: the momentum exchange gave values that are not finite in " << report.ice.exchange_failures
-              << " cell(s), the first at " << cellName(cell) << "; a material's density, volume fraction or velocity there is not finite (reduce the time step "
+              << " cell(s), the first at " << layout_->grid().cellName(cell) << "; a material's density, volume fraction or velocity there is not finite (reduce the time step "
                  "or check the materials' parameters)";
       throw StepFailure(message.str());
     }
@@ -253,7 +242,7 @@ void MpmIceStep<Dim>::checkFinite(const CellState<Dim>& state, bool with_pressur
     const long long gid = global_first / kKeysPerCell;
     const int f = int(global_first % kKeysPerCell) / 32, column = int(global_first % 32);
     std::ostringstream message;
-    message << "coupled step: " << cellName(gid) << ": ";
+    message << "coupled step: " << layout_->grid().cellName(gid) << ": ";
     const std::string& field = fields[f]->name();
     if (fields[f] == &state.pressure) {
       message << "the pressure";

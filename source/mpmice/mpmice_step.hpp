@@ -90,8 +90,6 @@ class MpmIceStep {
   /// material and the quantity, if a value of the state or of a particle is not finite
   /// (with_pressure false: the pressure is not looked at).
   void checkFinite(const CellState<Dim>& state, bool with_pressure = true) const;
-  /// "cell (i, j)" or "cell (i, j, k)" for a global cell id, for messages.
-  std::string cellName(long long global_id) const;
 
   Scene scene_;
   std::shared_ptr<const Layout<Dim>> layout_;

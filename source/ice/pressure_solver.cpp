@@ -724,8 +724,7 @@ void PressureSolver<Dim>::assemble(const Field<Dim>& mixture_compressibility, Fa
     std::ostringstream message;
     message << "pressure equation: ";
     if (reporter == first_reporter) {
-      const auto ijk = lay.grid().cellIndex(lay.ownedCellMap()->getGlobalElement(first_bad));
-      message << "cell (" << ijk[0] << ", " << ijk[1] << ", " << ijk[2] << ") has compressibility "
+      message << lay.grid().cellName(lay.ownedCellMap()->getGlobalElement(first_bad)) << " has compressibility "
               << kappa(first_bad, 0) << " 1/Pa (must be > 0) or a face coefficient that is negative or not finite"
               << " (faces x-, x+, y-, y+" << (Dim == 3 ? ", z-, z+" : "") << ":";
       for (int f = 0; f < 2 * Dim; ++f) {

@@ -128,7 +128,7 @@ class MpmSolver {
   // --- transfers of the coupled step (mpmice/): particles <-> cells ------------------------------
   /// Columns of a cell field for particlesToCells / addCellVelocityChange: per MPM material a,
   /// mass (column a), volume (materials + a) and momentum or velocity change (2 materials + a Dim + d),
-  /// then the face shares of particlesToCells (faceColumn) and the covers over the step (roomColumn).
+  /// then the face shares of particlesToCells (faceColumn).
   static int cellColumns(int materials) { return materials * (3 + 5 * Dim); }
   /// Column of material a's volume in a cell with every particle moved by Δt ṽ_p (particlesToCells).
   KOKKOS_INLINE_FUNCTION static int predictedVolumeColumn(int materials, int a) { return materials * (2 + 3 * Dim) + a; }

@@ -995,17 +995,6 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt, bool fore
       for (int d = 0; d < Dim; ++d) out(c, 2 * nm + m * Dim + d) += w * mp * velocity[d];
     }
     addMovedBox<Dim>(xp, lp, velocity, dt, Vp, origin, spacing, count, cells, out, predictedVolumeColumn(nm, m));
-    // Adds scale × (below, above) to the pair of columns from `column` (a face's sides) of the cells
-    // at face f of direction d, in proportion to the particle's overlap w with each of them across d.
-    const auto addToFace = [&](int column, int d, long long f, double scale, double below, double above) {
-      overlap.acrossDirection(d, [&](long long ijk[3], double w) {
-        ijk[d] = f;
-        const LocalOrdinal c = cells(ijk[0], ijk[1], ijk[2]);
-        if (c < 0) return;
-        out(c, column) += w * scale * below;
-        out(c, column + 1) += w * scale * above;
-      });
-    };
     // The cover over the step, per side: the share of the face that the box covers in the step as
     // the solid would cross it from that side. Below the face (side 0): the box's cover of the band
     // just below the face as it moves up by |Δx| = Δt |ṽ_p| / h; above it (side 1): of the band just
@@ -1025,7 +1014,15 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt, bool fore
         if (f < 1 || f > count[d] - 1) continue;  // domain faces are walls
         const double below = bandCoverOverStep(lo, hi, reach, f - band, double(f));
         const double above = bandCoverOverStep(lo, hi, -reach, double(f), f + band);
-        if (below > 0 || above > 0) addToFace(roomColumn(nm, m, d, 0), d, f, per_cover, below, above);
+        if (below <= 0 && above <= 0) continue;
+        overlap.acrossDirection(d, [&](long long ijk[3], double w) {
+          ijk[d] = f;
+          const LocalOrdinal c = cells(ijk[0], ijk[1], ijk[2]);
+          if (c < 0) return;
+          const int column = roomColumn(nm, m, d, 0);
+          out(c, column) += w * per_cover * below;
+          out(c, column + 1) += w * per_cover * above;
+        });
       }
     }
     // Face shares: the particle's volume in the layers of width `layer` cells
@@ -1038,6 +1035,18 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt, bool fore
     // ahead of a body that comes at a face, the fluid between them had to leave through the layer's
     // open part, ever faster as the gap closed. Averaged over the step, the open part is the time
     // the face is open, and the fluid crosses it at the body's speed either way.
+    // Adds scale × (below, above) to the face columns of the cells at face f of direction d, in
+    // proportion to the particle's overlap w with each of them across d.
+    const auto addToFace = [&](int d, long long f, double scale, double below, double above) {
+      overlap.acrossDirection(d, [&](long long ijk[3], double w) {
+        ijk[d] = f;
+        const LocalOrdinal c = cells(ijk[0], ijk[1], ijk[2]);
+        if (c < 0) return;
+        const int column = faceColumn(nm, m, d, 0);
+        out(c, column) += w * scale * below;
+        out(c, column + 1) += w * scale * above;
+      });
+    };
     if (table.rigid[m] && table.rigid_moving[m]) {
       for (int d = 0; d < Dim; ++d) {
         const double lo = (xp[d] - lp[d] - origin[d]) / spacing[d], hi = (xp[d] + lp[d] - origin[d]) / spacing[d];
@@ -1055,7 +1064,7 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt, bool fore
             const double a = (f - hi) / shift, b = (f - lo) / shift;
             time = math::max(0.0, math::min(1.0, math::max(a, b)) - math::max(0.0, math::min(a, b)));
           }
-          if (time > 0) addToFace(faceColumn(nm, m, d, 0), d, f, per_cover, time, time);
+          if (time > 0) addToFace(d, f, per_cover, time, time);
         }
       }
       return;
@@ -1068,7 +1077,7 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt, bool fore
         if (f < 1 || f > count[d] - 1) continue;  // domain faces are walls
         const double below = math::max(0.0, math::min(hi, double(f)) - math::max(lo, f - layer));
         const double above = math::max(0.0, math::min(hi, f + layer) - math::max(lo, double(f)));
-        if (below > 0 || above > 0) addToFace(faceColumn(nm, m, d, 0), d, f, per_length, below, above);
+        if (below > 0 || above > 0) addToFace(d, f, per_length, below, above);
       }
     }
   };

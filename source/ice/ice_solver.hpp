@@ -183,6 +183,11 @@ class IceSolver {
   /// reached its face), couples to the fluids on a face by its shares there, and a rigid solid closes
   /// the larger of its two shares. Fluids use their cells' volume fractions. Zero until set.
   FaceField<Dim>& solidFaceShares() { return solid_face_share_; }
+  /// Per solid and side of each face, the face's cover as the solid would cross it from that side
+  /// over the step (MpmSolver::roomColumn): the fluids' room there is at least what it leaves open
+  /// (fluidFaceFractions). Zero until set, which leaves every face open to the fluids: a caller that
+  /// sets solidFaceShares sets these too (the coupled step does).
+  FaceField<Dim>& solidFaceCovers() { return solid_face_cover_; }
   /// Each solid's change of volume fraction in every cell over the step if its particles moved with
   /// the velocity they have before the fluid pressure acts (columns: materials; owned cells), set by
   /// the coupled step. The pressure equation counts a solid's volume flux as this change plus, on
@@ -301,6 +306,7 @@ class IceSolver {
   FaceField<Dim> face_specific_volume_; // per material, after the face exchange
   FaceField<Dim> face_beta_;            // Σ θ_f v_f
   FaceField<Dim> solid_face_share_;     // solidFaceShares()
+  FaceField<Dim> solid_face_cover_;     // solidFaceCovers()
   long long first_failed_equilibration_ = -1;  // firstFailedEquilibration()
   Field<Dim> solid_volume_change_;      // solidVolumeChange()
   FaceField<Dim> solid_kinematic_velocity_;  // a solid's face velocity before pressure and exchange

@@ -22,6 +22,18 @@ constexpr int kMaxMaterials = 8;
 /// Below this fraction of its material's particle mass a node counts as empty (v = 0): GIMP
 /// weights near the edge of a particle's support are arbitrarily small.
 constexpr double kEmptyNodeMassFraction = 1e-12;
+// A solid's cover of a face over the step (particlesToCells, roomColumn; the fluids' room) is
+// measured in a band just below or just above the face. At rest the band is kFaceBandAtRest cells
+// wide, so that the cover of a face on which a surface rests does not jump between 0 and 1 as the
+// surface bulges past the face and back; in motion it narrows as w0² / (w0 + kFaceBandNarrowing |Δx|)
+// with the box's displacement Δx in the step (cells), so that the step's motion, not the band, times
+// a surface's crossing. Measured with this cover alone as the fluids' room (not kept; doc/mpmice.md):
+// 1e-5 cells wide at rest, the resting block of `ParticleVolumesKeepTheBlocksBuoyantWeight` carried
+// 1.066 of its buoyant weight (1.03 allowed; 0.990 at 1e-3); 1e-3 cells wide in motion too, the air
+// beside a block falling through air (0.5-0.8 m/s, Δx = 2-4e-3 cells) reached 75-330 times
+// potential flow's kinetic energy at each face crossing, 3-5 times with the band narrowed.
+constexpr double kFaceBandAtRest = 1e-3;
+constexpr double kFaceBandNarrowing = 40.0;
 
 /// Columns of the node sums: mass, momentum, force and (for contact) mass gradient per material.
 struct NodeColumns {
@@ -763,6 +775,23 @@ KOKKOS_INLINE_FUNCTION void particleGridVelocity(const double xp[Dim], const dou
   }
 }
 
+/// The share of the band [a, b] (in cells) that the interval [lo, hi] covers, averaged over a
+/// step in which the interval moves by `s`. The overlap of the sliding interval with the band is a
+/// trapezoid in the offset u, a sum of four ramps R(u − c) = max(u − c, 0) with signs + − − + at
+/// the corners c; each ramp's mean over the step is taken in a form without cancellation, exact
+/// for s = 0 too.
+KOKKOS_INLINE_FUNCTION double bandCoverOverStep(double lo, double hi, double s, double a, double b)
+{
+  const auto ramp_mean = [s](double c) {
+    if (c < math::min(0.0, s)) return 0.5 * s - c;  // on the ramp through the whole step
+    if (s > 0 && c < s) return 0.5 * (s - c) * (s - c) / s;
+    if (s < 0 && c < 0) return -0.5 * c * c / s;
+    return 0.0;
+  };
+  const double overlap = ramp_mean(a - hi) - ramp_mean(b - hi) - ramp_mean(a - lo) + ramp_mean(b - lo);
+  return math::min(1.0, math::max(0.0, overlap / (b - a)));
+}
+
 /// Adds V_p times the shares of the box of half-width l about x + Δt v (the particle moved by
 /// G2P) to column `column` of the cells it overlaps.
 template <int Dim, class CellView>
@@ -966,6 +995,39 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt, bool fore
       for (int d = 0; d < Dim; ++d) out(c, 2 * nm + m * Dim + d) += w * mp * velocity[d];
     }
     addMovedBox<Dim>(xp, lp, velocity, dt, Vp, origin, spacing, count, cells, out, predictedVolumeColumn(nm, m));
+    // Adds scale × (below, above) to the pair of columns from `column` (a face's sides) of the cells
+    // at face f of direction d, in proportion to the particle's overlap w with each of them across d.
+    const auto addToFace = [&](int column, int d, long long f, double scale, double below, double above) {
+      overlap.acrossDirection(d, [&](long long ijk[3], double w) {
+        ijk[d] = f;
+        const LocalOrdinal c = cells(ijk[0], ijk[1], ijk[2]);
+        if (c < 0) return;
+        out(c, column) += w * scale * below;
+        out(c, column + 1) += w * scale * above;
+      });
+    };
+    // The cover over the step, per side: the share of the face that the box covers in the step as
+    // the solid would cross it from that side. Below the face (side 0): the box's cover of the band
+    // just below the face as it moves up by |Δx| = Δt |ṽ_p| / h; above it (side 1): of the band just
+    // above the face as it moves down by |Δx|. Inside a body both are 1; on a surface at rest on the
+    // face, 1 on the body's side and 0 on the other; where a body's top leaves the face within the
+    // step (a falling block), the side it leaves from holds the share of the step before it leaves;
+    // where a surface reaches the face within the step, the share after it arrives. The fluids'
+    // room on the donor's side is at least what this leaves open (IceSolver::fluidFaceFractions).
+    for (int d = 0; d < Dim; ++d) {
+      const double lo = (xp[d] - lp[d] - origin[d]) / spacing[d], hi = (xp[d] + lp[d] - origin[d]) / spacing[d];
+      const double reach = math::abs(dt * velocity[d] / spacing[d]);  // |Δx|, in cells
+      const double band = kFaceBandAtRest * kFaceBandAtRest / (kFaceBandAtRest + kFaceBandNarrowing * reach);
+      const double per_cover = Vp / ((hi - lo) * cell_volume);  // share of a face per lateral share w
+      const long long first_face = (long long)math::floor(lo - reach - band);
+      const long long last_face = (long long)math::floor(hi + reach + band) + 1;
+      for (long long f = first_face; f <= last_face; ++f) {
+        if (f < 1 || f > count[d] - 1) continue;  // domain faces are walls
+        const double below = bandCoverOverStep(lo, hi, reach, f - band, double(f));
+        const double above = bandCoverOverStep(lo, hi, -reach, double(f), f + band);
+        if (below > 0 || above > 0) addToFace(roomColumn(nm, m, d, 0), d, f, per_cover, below, above);
+      }
+    }
     // Face shares: the particle's volume in the layers of width `layer` cells
     // (MpmOptions::face_layer) just below and just above each interior face its box reaches, per
     // volume of the layer. A moving rigid body's instead (both sides alike): the share of the face
@@ -976,18 +1038,6 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt, bool fore
     // ahead of a body that comes at a face, the fluid between them had to leave through the layer's
     // open part, ever faster as the gap closed. Averaged over the step, the open part is the time
     // the face is open, and the fluid crosses it at the body's speed either way.
-    // Adds scale × (below, above) to the face columns of the cells at face f of direction d, in
-    // proportion to the particle's overlap w with each of them across d.
-    const auto addToFace = [&](int d, long long f, double scale, double below, double above) {
-      overlap.acrossDirection(d, [&](long long ijk[3], double w) {
-        ijk[d] = f;
-        const LocalOrdinal c = cells(ijk[0], ijk[1], ijk[2]);
-        if (c < 0) return;
-        const int column = faceColumn(nm, m, d, 0);
-        out(c, column) += w * scale * below;
-        out(c, column + 1) += w * scale * above;
-      });
-    };
     if (table.rigid[m] && table.rigid_moving[m]) {
       for (int d = 0; d < Dim; ++d) {
         const double lo = (xp[d] - lp[d] - origin[d]) / spacing[d], hi = (xp[d] + lp[d] - origin[d]) / spacing[d];
@@ -1005,7 +1055,7 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt, bool fore
             const double a = (f - hi) / shift, b = (f - lo) / shift;
             time = math::max(0.0, math::min(1.0, math::max(a, b)) - math::max(0.0, math::min(a, b)));
           }
-          if (time > 0) addToFace(d, f, per_cover, time, time);
+          if (time > 0) addToFace(faceColumn(nm, m, d, 0), d, f, per_cover, time, time);
         }
       }
       return;
@@ -1018,7 +1068,7 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt, bool fore
         if (f < 1 || f > count[d] - 1) continue;  // domain faces are walls
         const double below = math::max(0.0, math::min(hi, double(f)) - math::max(lo, f - layer));
         const double above = math::max(0.0, math::min(hi, f + layer) - math::max(lo, double(f)));
-        if (below > 0 || above > 0) addToFace(d, f, per_length, below, above);
+        if (below > 0 || above > 0) addToFace(faceColumn(nm, m, d, 0), d, f, per_length, below, above);
       }
     }
   };

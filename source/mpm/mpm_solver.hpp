@@ -128,8 +128,8 @@ class MpmSolver {
   // --- transfers of the coupled step (mpmice/): particles <-> cells ------------------------------
   /// Columns of a cell field for particlesToCells / addCellVelocityChange: per MPM material a,
   /// mass (column a), volume (materials + a) and momentum or velocity change (2 materials + a Dim + d),
-  /// then the face shares of particlesToCells (faceColumn).
-  static int cellColumns(int materials) { return materials * (3 + 3 * Dim); }
+  /// then the face shares of particlesToCells (faceColumn) and the covers over the step (roomColumn).
+  static int cellColumns(int materials) { return materials * (3 + 5 * Dim); }
   /// Column of material a's volume in a cell with every particle moved by Δt ṽ_p (particlesToCells).
   KOKKOS_INLINE_FUNCTION static int predictedVolumeColumn(int materials, int a) { return materials * (2 + 3 * Dim) + a; }
   /// Column of material a's share of the lower face of a cell in direction d, in the layer below the
@@ -137,6 +137,12 @@ class MpmSolver {
   KOKKOS_INLINE_FUNCTION static int faceColumn(int materials, int a, int d, int side)
   {
     return materials * (2 + Dim) + 2 * (a * Dim + d) + side;
+  }
+  /// Column of material a's cover of the lower face of a cell in direction d as it would cross it
+  /// from below (side 0) or from above (side 1) over the step: what it leaves the fluids there.
+  KOKKOS_INLINE_FUNCTION static int roomColumn(int materials, int a, int d, int side)
+  {
+    return materials * (3 + 3 * Dim) + 2 * (a * Dim + d) + side;
   }
   /// Each particle's mass m_p, volume V_p and momentum m_p ṽ_p into the cells that its GIMP domain
   /// (the box of half-width l_p about it) overlaps, in proportion to the overlap (the part beyond a

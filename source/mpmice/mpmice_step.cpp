@@ -282,7 +282,11 @@ void MpmIceStep<Dim>::cellsFromParticles(CellState<Dim>& state, double dt)
   auto solid_u = solid_velocity_->view();
   auto change = ice_->solidVolumeChange().view();
   typename Field<Dim>::View face_share[3];
-  for (int d = 0; d < Dim; ++d) face_share[d] = ice_->solidFaceShares().direction(d).view();
+  typename Field<Dim>::View face_cover[3];
+  for (int d = 0; d < Dim; ++d) {
+    face_share[d] = ice_->solidFaceShares().direction(d).view();
+    face_cover[d] = ice_->solidFaceCovers().direction(d).view();
+  }
   // The sums are complete on the ghosts as well, so every local cell is set without a halo exchange.
   Kokkos::parallel_for(
       "mpmice::cellsFromParticles", Kokkos::RangePolicy<ExecutionSpace>(0, state.density.overlapCount()),
@@ -296,7 +300,8 @@ void MpmIceStep<Dim>::cellsFromParticles(CellState<Dim>& state, double dt)
           const int m = scene_index[a];
           for (int d = 0; d < Dim; ++d)
             for (int side = 0; side < 2; ++side)
-              face_share[d](c, 2 * m + side) = sums(c, mpm::MpmSolver<Dim>::faceColumn(nm, a, d, side));
+              face_share[d](c, 2 * m + side) = sums(c, mpm::MpmSolver<Dim>::faceColumn(nm, a, d, side)),
+              face_cover[d](c, 2 * m + side) = sums(c, mpm::MpmSolver<Dim>::roomColumn(nm, a, d, side));
           change(c, m) = (sums(c, mpm::MpmSolver<Dim>::predictedVolumeColumn(nm, a)) - sums(c, nm + a)) / volume;
           const double mass = sums(c, a);
           rho(c, m) = mass / volume;

@@ -692,6 +692,8 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
   const auto& slab = advector_->slabDensities(face_velocity_, dt, state.density);
   const auto v = state.specific_volume.view();
   const auto theta = state.volume_fraction.view();
+  const auto rho = state.density.view();
+  const auto u = state.velocity.view();
   const auto neighbours = layout_->cellNeighbours();
   const int n = materials_;
   const auto roles = roles_;
@@ -768,9 +770,31 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
             const double reached = Kokkos::Experimental::fmin(1.0, lesser / kFaceCoverRamp);
             covered = reached * (across + (fuller - across) * along4 * along4);
           }
+          // The cover over the step is for a surface that crosses the face; one that slides along
+          // it (the side of a body moving past the face) is where the layers say it is. Weighed by
+          // the share of the deformable solids' velocity at the face that is normal to it, |v_d| /
+          // |v| (the solids' momentum of both cells over their mass; 1 at rest).
+          double across_motion = 1.0;
+          {
+            double mass = 0, momentum[3] = {0, 0, 0};
+            for (int m = 0; m < n; ++m) {
+              if (!roles.lagrangian[m] || roles.rigid[m]) continue;
+              for (int k = 0; k < 2; ++k) {
+                const LocalOrdinal cell = k == 0 ? c : l;
+                if (cell < 0) continue;
+                const double r = rho(cell, m);
+                mass += r;
+                for (int e = 0; e < Dim; ++e) momentum[e] += r * u(cell, m * Dim + e);
+              }
+            }
+            double speed2 = 0;
+            for (int e = 0; e < Dim; ++e) speed2 += momentum[e] * momentum[e];
+            if (mass > 0 && speed2 > 0) across_motion = Kokkos::Experimental::fabs(momentum[d]) / Kokkos::Experimental::sqrt(speed2);
+          }
           double keep[2];
           for (int side = 0; side < 2; ++side) {
-            const double closed = Kokkos::Experimental::fmin(rigid[side] + covered, swept[side]);
+            const double layers = rigid[side] + covered;
+            const double closed = layers + across_motion * (Kokkos::Experimental::fmin(layers, swept[side]) - layers);
             const double room = closed < 1.0 ? 1.0 - closed : 0.0;
             const LocalOrdinal donor = side == 0 ? l : c;
             double donor_solid = 0;

@@ -778,7 +778,7 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
           // velocity swung at 16-18 ms (growth 5.6 against 2.7 weighed; doc/stability.md, (b)); on
           // the faces it crosses only, it mends the falling block's crossings as before.
           double across_motion = 1.0;
-          {
+          if (swept[0] < rigid[0] + covered || swept[1] < rigid[1] + covered) {  // else the layers hold anyway
             double mass = 0, momentum[3] = {0, 0, 0};
             for (int m = 0; m < n; ++m) {
               if (!roles.lagrangian[m] || roles.rigid[m]) continue;

@@ -1012,8 +1012,9 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt, bool fore
     // above the face as it moves down by |Δx|. Inside a body both are 1; on a surface at rest on the
     // face, 1 on the body's side and 0 on the other; where a body's top leaves the face within the
     // step (a falling block), the side it leaves from holds the share of the step before it leaves;
-    // where a surface reaches the face within the step, the share after it arrives. The fluids'
-    // room on the donor's side is at least what this leaves open (IceSolver::fluidFaceFractions).
+    // where a surface reaches the face within the step, the share after it arrives. Where the solid
+    // moves across the face the fluids' room on the donor's side is at least what this leaves open
+    // (IceSolver::fluidFaceFractions).
     for (int d = 0; d < Dim; ++d) {
       const double lo = (xp[d] - lp[d] - origin[d]) / spacing[d], hi = (xp[d] + lp[d] - origin[d]) / spacing[d];
       const double reach = math::abs(dt * velocity[d] / spacing[d]);  // |Δx|, in cells

@@ -299,9 +299,10 @@ void MpmIceStep<Dim>::cellsFromParticles(CellState<Dim>& state, double dt)
         for (int a = 0; a < nm; ++a) {
           const int m = scene_index[a];
           for (int d = 0; d < Dim; ++d)
-            for (int side = 0; side < 2; ++side)
-              face_share[d](c, 2 * m + side) = sums(c, mpm::MpmSolver<Dim>::faceColumn(nm, a, d, side)),
+            for (int side = 0; side < 2; ++side) {
+              face_share[d](c, 2 * m + side) = sums(c, mpm::MpmSolver<Dim>::faceColumn(nm, a, d, side));
               face_cover[d](c, 2 * m + side) = sums(c, mpm::MpmSolver<Dim>::roomColumn(nm, a, d, side));
+            }
           change(c, m) = (sums(c, mpm::MpmSolver<Dim>::predictedVolumeColumn(nm, a)) - sums(c, nm + a)) / volume;
           const double mass = sums(c, a);
           rho(c, m) = mass / volume;

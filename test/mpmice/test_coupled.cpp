@@ -269,12 +269,12 @@ TEST(CoupledStep, LightBodyRisesWithTheAddedMassOfPotentialFlow)
 // tank, five blocks wide, raises that by a factor of order one (measured before any crossing:
 // 2.0-2.55 times). Bound: ten times potential flow's over the whole fall, which holds three face
 // crossings of the block's top and bottom together (at 0.045, 0.064 and 0.078 s; measured 3.47
-// times at most, the same on 1 and 2 ranks). Each crossing has failed before (doc/mpmice.md, "the fluids' room on a face"): with the
-// room taken from the donor's layer alone the air crossed into the block's cells at the first and
-// was trapped there (1.9e5 times the bound, the block 20 % slower than g t); with the cover ramped
-// in by the lesser of the layers beside the face the face the top left within a step stayed
-// covered for the whole step, and the air that had to follow the block reached 1220 and 440 times
-// potential flow's at the second and third.
+// times at most, the same on 1 and 2 ranks). Each crossing has failed before (doc/mpmice.md, "the
+// fluids' room on a face"): with the room taken from the donor's layer alone the air crossed into
+// the block's cells at the first and was trapped there (1.9e5 times the bound, the block 20 %
+// slower than g t); with the cover ramped in by the lesser of the layers beside the face, the face
+// the top left within a step stayed covered for the whole step, and the air that had to follow the
+// block reached 1220 and 440 times potential flow's at the second and third.
 TEST(CoupledStep, BlockFallingThroughAirKeepsTheAirToItsOwnFlow)
 {
   const double a = 0.04, rho_air = 101325.0 / (287.0 * 293.15), g = 9.81, end = 0.08;

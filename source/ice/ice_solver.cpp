@@ -722,20 +722,23 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
             leaves(c, 2 * d) = 1.0;
             return;
           }
+          // A solid's columns of `out` stay as constructed, zero: nothing reads them (a solid's
+          // flux takes its share of the face), and leaving them unwritten spares the kernel, which
+          // memory bounds, a quarter of its streams.
           double fluid[2] = {0, 0}, rigid[2] = {0, 0}, deformable[2] = {0, 0}, swept[2] = {0, 0};
+          double profile[2][ice::kMaxMaterials];  // each fluid's profile on the face, per donor side
           for (int m = 0; m < n; ++m) {
             if (roles.lagrangian[m] || roles.rigid[m]) {
               for (int side = 0; side < 2; ++side) {
                 (roles.rigid[m] ? rigid : deformable)[side] += minOf(1.0, share(c, 2 * m + side));
                 swept[side] += minOf(1.0, cover(c, 2 * m + side));
               }
-              out(c, 2 * m) = out(c, 2 * m + 1) = 0.0;
               continue;
             }
             // Donor below the face (its upper face 2 d + 1) and donor above (this cell's lower face).
-            out(c, 2 * m) = l >= 0 ? slab(l, 2 * d + 1, m) * v(l, m) : theta(c, m);
-            out(c, 2 * m + 1) = slab(c, 2 * d, m) * v(c, m);
-            fluid[0] += out(c, 2 * m), fluid[1] += out(c, 2 * m + 1);
+            profile[0][m] = l >= 0 ? slab(l, 2 * d + 1, m) * v(l, m) : theta(c, m);
+            profile[1][m] = slab(c, 2 * d, m) * v(c, m);
+            fluid[0] += profile[0][m], fluid[1] += profile[1][m];
           }
           // The fluids cross a face in the room the solids leave there. A cell's linear profile
           // cannot hold the sharp edge of a solid inside the cell: above a sand surface it would
@@ -830,7 +833,8 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
             }
           }
           for (int m = 0; m < n; ++m)
-            for (int side = 0; side < 2; ++side) out(c, 2 * m + side) *= keep[side];
+            if (!roles.lagrangian[m] && !roles.rigid[m])
+              for (int side = 0; side < 2; ++side) out(c, 2 * m + side) = profile[side][m] * keep[side];
           if (l >= 0) leaves(l, 2 * d + 1) = keep[0];
           leaves(c, 2 * d) = keep[1];
         });

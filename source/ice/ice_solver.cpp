@@ -1,6 +1,7 @@
 #include "ice/ice_solver.hpp"
 
 #include "common/error.hpp"
+#include "common/kernel_math.hpp"
 
 #include "ice/equilibration.hpp"
 #include "ice/exchange.hpp"
@@ -20,13 +21,6 @@
 namespace cfdmpm {
 
 namespace {
-
-// min and max for the kernels: a comparison the compiler inlines. Kokkos's fmin and fmax are
-// calls into the C library here (their NaN rules keep GCC from inlining them at -O3), which cost
-// fluidFaceFractions, called twice per coupled step on every face, 16 % of its time. Unlike fmin,
-// a NaN in `a` is passed on rather than dropped.
-KOKKOS_INLINE_FUNCTION double minOf(double a, double b) { return b < a ? b : a; }
-KOKKOS_INLINE_FUNCTION double maxOf(double a, double b) { return b > a ? b : a; }
 
 constexpr double kTiny = 1e-100;  // guards divisions by a vanishing mass or density
 
@@ -160,9 +154,8 @@ KOKKOS_INLINE_FUNCTION double rigidClosedShare(int materials, const MaterialRole
   double closed = 0;
   for (int m = 0; m < materials; ++m)
     if (roles.rigid[m])
-      closed += maxOf(minOf(1.0, share(upper, 2 * m)),
-                                           minOf(1.0, share(upper, 2 * m + 1)));
-  return minOf(1.0, closed);
+      closed += math::max(math::min(1.0, share(upper, 2 * m)), math::min(1.0, share(upper, 2 * m + 1)));
+  return math::min(1.0, closed);
 }
 
 // Whether the face between cells c and l (l < 0: none) is shut because either cell is closed
@@ -631,8 +624,8 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
             if (with_solids)
               for (int m = 0; m < nm; ++m)
                 if (roles.lagrangian[m]) {
-                  fl[m] = minOf(1.0, share(c, 2 * m));
-                  fr[m] = minOf(1.0, share(c, 2 * m + 1));
+                  fl[m] = math::min(1.0, share(c, 2 * m));
+                  fr[m] = math::min(1.0, share(c, 2 * m + 1));
                 }
             ice::exchangeMomentumFC<N>(nm, dt, K, fl, fr, vl, vr, vel, sv);
             // A material absent on both sides has no weight in the exchange and would keep its own
@@ -730,8 +723,8 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
           for (int m = 0; m < n; ++m) {
             if (roles.lagrangian[m] || roles.rigid[m]) {
               for (int side = 0; side < 2; ++side) {
-                (roles.rigid[m] ? rigid : deformable)[side] += minOf(1.0, share(c, 2 * m + side));
-                swept[side] += minOf(1.0, cover(c, 2 * m + side));
+                (roles.rigid[m] ? rigid : deformable)[side] += math::min(1.0, share(c, 2 * m + side));
+                swept[side] += math::min(1.0, cover(c, 2 * m + side));
               }
               continue;
             }
@@ -772,12 +765,12 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
           // side (solidFaceCovers) leaves it open; where that cover is the larger, the layers'
           // (continuous as a surface rests on a face) holds.
           double covered = 0;
-          const double lesser = minOf(deformable[0], deformable[1]);
+          const double lesser = math::min(deformable[0], deformable[1]);
           if (lesser > 0) {
             const double across = 0.5 * (deformable[0] + deformable[1]);
-            const double fuller = minOf(1.0, maxOf(deformable[0], deformable[1]));
+            const double fuller = math::min(1.0, math::max(deformable[0], deformable[1]));
             const double along = fuller * fuller, along4 = along * along;
-            const double reached = minOf(1.0, lesser / kFaceCoverRamp);
+            const double reached = math::min(1.0, lesser / kFaceCoverRamp);
             covered = reached * (across + (fuller - across) * along4 * along4);
           }
           // The cover over the step is for a surface that crosses the face; one that slides along
@@ -807,7 +800,7 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
           double keep[2];
           for (int side = 0; side < 2; ++side) {
             const double layers = rigid[side] + covered;
-            const double closed = layers + across_motion * (minOf(layers, swept[side]) - layers);
+            const double closed = layers + across_motion * (math::min(layers, swept[side]) - layers);
             const double room = closed < 1.0 ? 1.0 - closed : 0.0;
             const LocalOrdinal donor = side == 0 ? l : c;
             double donor_solid = 0;
@@ -825,7 +818,7 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
             if (fill) {
               double speed = 0, held = 0;  // the solids' fastest face velocity out of the donor
               for (int m = 0; m < n; ++m) {
-                if (roles.lagrangian[m]) speed = maxOf(speed, side == 0 ? kinematic(c, m) : -kinematic(c, m));
+                if (roles.lagrangian[m]) speed = math::max(speed, side == 0 ? kinematic(c, m) : -kinematic(c, m));
                 else if (!roles.rigid[m]) held += theta(donor, m);
               }
               const double carried = speed * dt_per_h * fluid[side] * keep[side];
@@ -887,11 +880,11 @@ void IceSolver<Dim>::carriedFaceBeta(int outer_iteration)
             if (roles.rigid[m]) continue;
             const bool solid = roles.lagrangian[m];
             if (solid && !solid_faces) continue;
-            const double below = solid ? minOf(1.0, share(c, 2 * m)) : fluid(c, 2 * m);
-            const double above = solid ? minOf(1.0, share(c, 2 * m + 1)) : fluid(c, 2 * m + 1);
+            const double below = solid ? math::min(1.0, share(c, 2 * m)) : fluid(c, 2 * m);
+            const double above = solid ? math::min(1.0, share(c, 2 * m + 1)) : fluid(c, 2 * m + 1);
             const double w = uf(c, m);
             // The side rule of pressureRightHandSide's flux: below when w > 0, else above.
-            const double carried = upwind && w != 0 ? (w > 0 ? below : above) : maxOf(below, above);
+            const double carried = upwind && w != 0 ? (w > 0 ? below : above) : math::max(below, above);
             b += vf(c, m) * carried;
           }
           beta(c, 0) = b > 0 ? b : 0.0;
@@ -987,7 +980,7 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
             if (roles.lagrangian[m]) {
               if (!solid_faces) return 0.0;
               const auto crossing = [&](double velocity) {
-                return velocity * minOf(1.0, share[d](upper, velocity > 0 ? 2 * m : 2 * m + 1));
+                return velocity * math::min(1.0, share[d](upper, velocity > 0 ? 2 * m : 2 * m + 1));
               };
               return crossing(w) - crossing(kinematic[d](upper, m));
             }
@@ -1215,8 +1208,8 @@ void IceSolver<Dim>::momentumSourcePhase(CellState<Dim>& state, double dt)
                 else if (!roles.lagrangian[m]) fluid += theta(cell, m);
               }
               const double share = fluid + solid > 0 ? fluid / (fluid + solid) : 1.0;
-              const double weight = minOf(
-                  1.0, maxOf(0.0, (share - kPoreShareLow) / (kPoreShareHigh - kPoreShareLow)));
+              const double weight =
+                  math::min(1.0, math::max(0.0, (share - kPoreShareLow) / (kPoreShareHigh - kPoreShareLow)));
               return p_ref(cell, 0) + weight * (p(cell, 0) - p_ref(cell, 0));
             };
             const double p_c = acting(c);
@@ -1338,8 +1331,8 @@ void IceSolver<Dim>::filterOddEven(const CellState<Dim>& state)
         // A trace left by the advection can be below zero by round-off (a donor that gave all of
         // its mass); it weighs nothing (a negative weight larger than ρ_c blew the level of a
         // trace up to 1e28 m/s beside the softer sand at 10 mm).
-        const double ro = maxOf(0.0, rho(o, col / Dim));
-        sum += minOf(rc, ro) * (v(o, col) - v(c, col));
+        const double ro = math::max(0.0, rho(o, col / Dim));
+        sum += math::min(rc, ro) * (v(o, col) - v(c, col));
       }
       return sum;
     };
@@ -1869,7 +1862,7 @@ TimeStepLimit IceSolver<Dim>::stableTimeStep(const CellState<Dim>& state, double
         KOKKOS_LAMBDA(const LocalOrdinal c, double& worst) {
           if (theta(c, m) < 1e-6) return;
           double s = 0;
-          for (int d = 0; d < Dim; ++d) s = maxOf(s, Kokkos::Experimental::fabs(u(c, m * Dim + d)) * inv_h[d]);
+          for (int d = 0; d < Dim; ++d) s = math::max(s, Kokkos::Experimental::fabs(u(c, m * Dim + d)) * inv_h[d]);
           if (s > worst) worst = s;
         },
         Kokkos::Max<double>(rate));

@@ -12,25 +12,11 @@
 // contract(A, B) = A : B = sum_ij A_ij B_ij.
 #include <Kokkos_Core.hpp>
 
+#include "common/kernel_math.hpp"
+
 #include <cfloat>
 
 namespace cfdmpm::mpm {
-
-/// Device-safe math: Kokkos 3.4 keeps these in Kokkos::Experimental, Kokkos >= 3.7 in Kokkos.
-namespace math {
-#if KOKKOS_VERSION >= 30700
-#define CFDMPM_KOKKOS_MATH Kokkos
-#else
-#define CFDMPM_KOKKOS_MATH Kokkos::Experimental
-#endif
-KOKKOS_INLINE_FUNCTION double sqrt(double x) { return CFDMPM_KOKKOS_MATH::sqrt(x); }
-KOKKOS_INLINE_FUNCTION double cbrt(double x) { return CFDMPM_KOKKOS_MATH::cbrt(x); }
-KOKKOS_INLINE_FUNCTION double floor(double x) { return CFDMPM_KOKKOS_MATH::floor(x); }
-KOKKOS_INLINE_FUNCTION double abs(double x) { return CFDMPM_KOKKOS_MATH::fabs(x); }
-#undef CFDMPM_KOKKOS_MATH
-KOKKOS_INLINE_FUNCTION double max(double a, double b) { return a > b ? a : b; }
-KOKKOS_INLINE_FUNCTION double min(double a, double b) { return a < b ? a : b; }
-}  // namespace math
 
 /// Dim x Dim matrix held by value; zero on default construction.
 template <int Dim>

@@ -795,7 +795,7 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
             }
             double speed2 = 0;
             for (int e = 0; e < Dim; ++e) speed2 += momentum[e] * momentum[e];
-            if (mass > 0 && speed2 > 0) across_motion = Kokkos::Experimental::fabs(momentum[d]) / Kokkos::Experimental::sqrt(speed2);
+            if (mass > 0 && speed2 > 0) across_motion = math::abs(momentum[d]) / math::sqrt(speed2);
           }
           double keep[2];
           for (int side = 0; side < 2; ++side) {
@@ -1043,7 +1043,7 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
           outer_weight(c, 0) = weight;
           // A value that is not finite counts as infinite (a NaN would lose every comparison and
           // vanish from the maximum), so that the outer iteration sees it and stops.
-          const double a = Kokkos::Experimental::isfinite(rhs(c, 0)) ? weight * Kokkos::Experimental::fabs(rhs(c, 0)) : INFINITY;
+          const double a = Kokkos::Experimental::isfinite(rhs(c, 0)) ? weight * math::abs(rhs(c, 0)) : INFINITY;
           if (a > worst) worst = a;
         },
         Kokkos::Max<double>(local_max));
@@ -1519,7 +1519,7 @@ void IceSolver<Dim>::equilibrationPhase(CellState<Dim>& state, IceStepReport& re
   Kokkos::parallel_reduce(
       "ice::equilibrationJump", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
       KOKKOS_LAMBDA(const LocalOrdinal c, double& largest) {
-        const double change = Kokkos::Experimental::fabs(after(c, 0) - before(c, 0));
+        const double change = math::abs(after(c, 0) - before(c, 0));
         if (change > largest) largest = change;
       },
       Kokkos::Max<double>(jump));
@@ -1758,7 +1758,7 @@ std::string IceSolver<Dim>::largestResidualCell(const CellState<Dim>& state) con
   Kokkos::parallel_reduce(
       "ice::largestResidualCell", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
       KOKKOS_LAMBDA(const LocalOrdinal c, typename Location::value_type& best) {
-        const double a = Kokkos::Experimental::isfinite(rhs(c, 0)) ? weight(c, 0) * Kokkos::Experimental::fabs(rhs(c, 0)) : INFINITY;
+        const double a = Kokkos::Experimental::isfinite(rhs(c, 0)) ? weight(c, 0) * math::abs(rhs(c, 0)) : INFINITY;
         if (a > best.val) best.val = a, best.loc = c;
       },
       Location(local));
@@ -1862,7 +1862,7 @@ TimeStepLimit IceSolver<Dim>::stableTimeStep(const CellState<Dim>& state, double
         KOKKOS_LAMBDA(const LocalOrdinal c, double& worst) {
           if (theta(c, m) < 1e-6) return;
           double s = 0;
-          for (int d = 0; d < Dim; ++d) s = math::max(s, Kokkos::Experimental::fabs(u(c, m * Dim + d)) * inv_h[d]);
+          for (int d = 0; d < Dim; ++d) s = math::max(s, math::abs(u(c, m * Dim + d)) * inv_h[d]);
           if (s > worst) worst = s;
         },
         Kokkos::Max<double>(rate));

@@ -185,8 +185,9 @@ class IceSolver {
   FaceField<Dim>& solidFaceShares() { return solid_face_share_; }
   /// Per solid and side of each face, the face's cover as the solid would cross it from that side
   /// over the step (MpmSolver::roomColumn): where the solid moves across the face the fluids' room
-  /// there is at least what it leaves open (fluidFaceFractions). Zero until set, which leaves every face open to the fluids: a caller that
-  /// sets solidFaceShares sets these too (the coupled step does).
+  /// there is at least what it leaves open (fluidFaceFractions). Zero until set, which leaves every
+  /// face open to the fluids: a caller that sets solidFaceShares sets these too (the coupled step
+  /// does).
   FaceField<Dim>& solidFaceCovers() { return solid_face_cover_; }
   /// Each solid's change of volume fraction in every cell over the step if its particles moved with
   /// the velocity they have before the fluid pressure acts (columns: materials; owned cells), set by

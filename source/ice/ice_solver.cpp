@@ -50,11 +50,22 @@ KOKKOS_INLINE_FUNCTION bool cavitating(const ice::Eos& eos, double p)
 {
   return eos.kind == ice::EosKind::LinearWater && p < eos.linear_water.cavitation_pressure;
 }
+/// A liquid that boils (a cavitation pressure) at a pressure where its law's density, p ρ_c / p_c,
+/// is not positive.
+KOKKOS_INLINE_FUNCTION bool boilsWithoutDensity(const ice::Eos& eos, double p)
+{
+  return eos.kind == ice::EosKind::LinearWater && eos.linear_water.cavitation_pressure > 0 && !(p > 0);
+}
 /// The share of its volume material m (EOS `eos`, temperature T, compressibility κ at the
 /// equilibration pressure p) loses when the pressure rises by Σδp.
 KOKKOS_INLINE_FUNCTION double materialVolumeLoss(const ice::Eos& eos, double p, double T, double kappa, double sum_dp)
 {
-  if (sum_dp > 0 && cavitating(eos, p)) return 1.0 - eos.density(p, T) / eos.density(p + sum_dp, T);
+  if (sum_dp > 0 && cavitating(eos, p)) {
+    // At p <= 0 (a cell whose root a solid set, the liquid a trace there) a boiling liquid's law
+    // has no density: its volume does not change.
+    if (boilsWithoutDensity(eos, p)) return 0.0;
+    return 1.0 - eos.density(p, T) / eos.density(p + sum_dp, T);
+  }
   return volumeLoss(kappa * sum_dp);
 }
 /// θ times its derivative with respect to Σδp (1/Pa): the material's term of the matrix's Σθκ.
@@ -62,6 +73,7 @@ KOKKOS_INLINE_FUNCTION double materialVolumeLossSlope(const ice::Eos& eos, doubl
                                                       double kappa, double sum_dp)
 {
   if (sum_dp > 0 && cavitating(eos, p)) {
+    if (boilsWithoutDensity(eos, p)) return 0.0;  // (materialVolumeLoss)
     const double rho = eos.density(p + sum_dp, T);
     return theta * (eos.density(p, T) / (rho * rho * eos.dp_drho(rho, T)));
   }
@@ -507,8 +519,17 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
             // of water stretched to -72 MPa (K = 1e5 Pa: the softer sand at 10 mm) got
             // 1e-306..5e-312 kg/m^3, a specific volume of 1e305 or infinity, which the cell's
             // momentum exchange turned into NaN at every Δt.
+            // A boiling liquid without mass takes at most its vapour's specific volume at the
+            // cavitation pressure: a trace of water in a sand the fluids see stretched below 0 Pa
+            // (no root for it; its law's density is p ρ_c / p_c) kept a specific volume from near
+            // 0 Pa, ~1e12 m³/kg, closed to θ = 1.28 after the advection, and the Lagrangian volume
+            // change at p < 0 turned it to −4e69 (a Drucker-Prager column under water, 0.2 s).
+            const double floor =
+                eos[m].kind == ice::EosKind::LinearWater ? eos[m].linear_water.cavitationDensity(temperature[m]) : 0.0;
             if (kSolids && roles.lagrangian[m] && !(mass_density[m] > 0))
               v(c, m) = particle_volume(c, m);
+            else if (!(mass_density[m] > 0) && floor > 0 && !(r.density[m] > floor))
+              v(c, m) = 1.0 / floor;
             else if (mass_density[m] > 0 || (r.density[m] > 0 && r.density[m] < DBL_MAX))
               v(c, m) = 1.0 / r.density[m];
             kappa(c, m) = r.compressibility[m] > 0 && r.compressibility[m] < DBL_MAX ? r.compressibility[m] : 0.0;
@@ -1752,6 +1773,23 @@ bool IceSolver<Dim>::followCompressibility(const CellState<Dim>& state)
   return true;
 }
 
+namespace {
+// Of a value per rank at one of its owned cells (`local`, at local index `loc`): the largest over
+// the ranks (`global_value`) and the lowest global cell id among the ranks that hold it
+// (`global_id`; LLONG_MAX if no rank has a cell); `id` is this rank's cell's global id if it holds
+// the largest, else LLONG_MAX.
+template <int Dim>
+void largestOverRanks(const Layout<Dim>& layout, double local, LocalOrdinal loc, double& global_value, long long& id,
+                      long long& global_id)
+{
+  Teuchos::reduceAll(*layout.comm(), Teuchos::REDUCE_MAX, local, Teuchos::outArg(global_value));
+  id = LLONG_MAX;
+  if (layout.ownedCells() > 0 && local == global_value) id = layout.ownedCellMap()->getGlobalElement(loc);
+  global_id = LLONG_MAX;
+  Teuchos::reduceAll(*layout.comm(), Teuchos::REDUCE_MIN, id, Teuchos::outArg(global_id));
+}
+}  // namespace
+
 template <int Dim>
 std::string IceSolver<Dim>::largestResidualCell(const CellState<Dim>& state) const
 {
@@ -1768,12 +1806,8 @@ std::string IceSolver<Dim>::largestResidualCell(const CellState<Dim>& state) con
       },
       Location(local));
   double global_value = 0;
-  Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_MAX, local.val, Teuchos::outArg(global_value));
-  // The lowest global cell id among the ranks that hold the largest value.
-  long long id = LLONG_MAX;
-  if (layout_->ownedCells() > 0 && local.val == global_value) id = layout_->ownedCellMap()->getGlobalElement(local.loc);
-  long long global_id = LLONG_MAX;
-  Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_MIN, id, Teuchos::outArg(global_id));
+  long long id = 0, global_id = 0;
+  largestOverRanks(*layout_, local.val, local.loc, global_value, id, global_id);
   // The volume fractions travel from the rank that holds the cell (the others send zeros).
   const int n = materials_;
   std::vector<double> fractions(n, 0.0), global_fractions(n, 0.0);
@@ -1844,6 +1878,16 @@ void IceSolver<Dim>::advectionPhase(CellState<Dim>& state, double dt, IceStepRep
   }
 }
 
+// Σ_n θ_n(c) over the materials n other than m.
+template <class Fractions>
+KOKKOS_INLINE_FUNCTION double othersShare(const Fractions& theta, LocalOrdinal c, int m, int n)
+{
+  double others = 0;
+  for (int k = 0; k < n; ++k)
+    if (k != m) others += theta(c, k);
+  return others;
+}
+
 template <int Dim>
 TimeStepLimit IceSolver<Dim>::stableTimeStep(const CellState<Dim>& state, double previous_dt) const
 {
@@ -1875,13 +1919,16 @@ TimeStepLimit IceSolver<Dim>::stableTimeStep(const CellState<Dim>& state, double
     // Σ_n θ_n above 1) does not limit the viscous step: its explicit viscous change is the force
     // θ μ ∇²u on it whatever its density, and the exchange gives it the mixture's velocity. (Air
     // expanded into a gap of the sand's cells, at tens of Pa, had ν = μ v ~ 0.1 m²/s and a viscous
-    // step of 1e-6 s.)
+    // step of 1e-6 s.) Σ_n θ_n over the other materials, not 1 − θ_m: a trace of boiling water
+    // advected into a cell of sand at ~0 Pa (its specific volume ~1e12 m³/kg) closed to θ = 1.28
+    // there until the next equilibration, 1 − θ_m was negative, and its viscous step of 9e-15 s
+    // held the run at time.dt_min (a Drucker-Prager column collapsing under water, 0.191 s).
     const double K = settings_.exchange_coefficient;
     Kokkos::parallel_reduce(
         "ice::viscousLimit", Kokkos::RangePolicy<ExecutionSpace>(0, state.velocity.ownedCount()),
         KOKKOS_LAMBDA(const LocalOrdinal c, double& worst) {
           if (theta(c, m) < 1e-6) return;
-          if (previous_dt * v(c, m) * K * (1.0 - theta(c, m)) > 1.0) return;
+          if (previous_dt * v(c, m) * K * othersShare(theta, c, m, n) > 1.0) return;
           if (v(c, m) > worst) worst = v(c, m);
         },
         Kokkos::Max<double>(max_nu));
@@ -1901,8 +1948,69 @@ TimeStepLimit IceSolver<Dim>::stableTimeStep(const CellState<Dim>& state, double
   }
   if (previous_dt > 0 && settings_.dt_growth * previous_dt < limit.dt)
     limit = {settings_.dt_growth * previous_dt, "growth"};
-  if (limit.dt < scene_.time.dt_min) limit = {scene_.time.dt_min, limit.limiter + ",dt_min"};
+  // Below time.dt_min the run cannot go on (the driver stops it): say which cell sets the limit.
+  if (limit.dt < scene_.time.dt_min) {
+    for (int m = 0; m < n; ++m) {
+      const int kind = limit.limiter == "convection(" + names_[m] + ")"  ? 0
+                       : limit.limiter == "viscosity(" + names_[m] + ")" ? 1
+                       : limit.limiter == "conduction(" + names_[m] + ")" ? 2
+                                                                          : -1;
+      if (kind >= 0) limit.where = limitingCell(state, m, kind, previous_dt);
+    }
+  }
   return limit;
+}
+
+// The owned cell (over all ranks, the lowest global id on a tie) where material m sets the limit of
+// kind 0 (convection: largest |u_d| / h_d), 1 or 2 (viscosity, conduction: largest specific volume
+// among the cells that limit), as stableTimeStep counts them; its name, the material's volume
+// fraction, density and velocity there.
+template <int Dim>
+std::string IceSolver<Dim>::limitingCell(const CellState<Dim>& state, int m, int kind, double previous_dt) const
+{
+  const auto u = state.velocity.view();
+  const auto theta = state.volume_fraction.view();
+  const auto v = state.specific_volume.view();
+  double inv_h[3];
+  for (int d = 0; d < Dim; ++d) inv_h[d] = 1.0 / layout_->grid().spacing()[d];
+  const double K = settings_.exchange_coefficient;
+  const int n = materials_;
+  using Location = Kokkos::MaxLoc<double, LocalOrdinal>;
+  typename Location::value_type local;
+  Kokkos::parallel_reduce(
+      "ice::limitingCell", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+      KOKKOS_LAMBDA(const LocalOrdinal c, typename Location::value_type& best) {
+        if (theta(c, m) < 1e-6) return;
+        double a = 0;
+        if (kind == 0) {
+          for (int d = 0; d < Dim; ++d) a = math::max(a, math::abs(u(c, m * Dim + d)) * inv_h[d]);
+        } else if (!(previous_dt * v(c, m) * K * othersShare(theta, c, m, n) > 1.0)) {
+          a = v(c, m);
+        }
+        if (a > best.val) best.val = a, best.loc = c;
+      },
+      Location(local));
+  double global_value = 0;
+  long long id = 0, global_id = 0;
+  largestOverRanks(*layout_, local.val, local.loc, global_value, id, global_id);
+  if (global_id == LLONG_MAX) return "";
+  // The values travel from the rank that holds the cell (the others send zeros).
+  std::vector<double> values(2 + Dim, 0.0), global_values(2 + Dim, 0.0);
+  if (id == global_id) {
+    auto column = [&](const auto& view, int k) {
+      return Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), Kokkos::subview(view, local.loc, k))();
+    };
+    values[0] = column(theta, m);
+    values[1] = 1.0 / column(v, m);
+    for (int d = 0; d < Dim; ++d) values[2 + d] = column(u, m * Dim + d);
+  }
+  Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_SUM, 2 + Dim, values.data(), global_values.data());
+  std::ostringstream text;
+  text << layout_->grid().cellName(global_id) << ", where " << names_[m] << " fills " << std::setprecision(3)
+       << global_values[0] << " of the cell at " << global_values[1] << " kg/m^3 and moves at (";
+  for (int d = 0; d < Dim; ++d) text << (d ? ", " : "") << global_values[2 + d];
+  text << ") m/s";
+  return text.str();
 }
 
 template <int Dim>

@@ -28,6 +28,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace cfdmpm {
@@ -84,8 +85,13 @@ struct MaterialRoles {
 
 /// The time-step limit and what set it.
 struct TimeStepLimit {
-  double dt = 0;
+  TimeStepLimit(double dt_ = 0, std::string limiter_ = {}, std::string where_ = {})
+      : dt(dt_), limiter(std::move(limiter_)), where(std::move(where_))
+  {
+  }
+  double dt;
   std::string limiter;  // e.g. "convection(water)", "viscosity(air)", "dt_max", "growth"
+  std::string where;    // the cell that sets a fluid's limit, when that limit is below time.dt_min
 };
 
 /// A solid (MPM) material as the ICE phases see it (the coupled step fills these from the MPM
@@ -218,7 +224,8 @@ class IceSolver {
   }
 
   /// The largest stable Δt for the state (convective CFL and viscous limits), at most
-  /// growth × previous_dt and within [dt_min, dt_max].
+  /// growth × previous_dt and dt_max. Below time.dt_min it names the cell that sets it (`where`)
+  /// and the run stops there.
   TimeStepLimit stableTimeStep(const CellState<Dim>& state, double previous_dt) const;
 
   /// Brings the state's volume fractions, specific volumes and pressure to equilibrium (step [3]);
@@ -241,6 +248,9 @@ class IceSolver {
   /// "cell (i, j): ..." for the cell whose weighted volume residual (the outer test's) is the
   /// largest on any rank, with its materials' volume fractions; the same text on every rank.
   std::string largestResidualCell(const CellState<Dim>& state) const;
+  /// "cell (i, j), where <material> fills ..." for the cell where material m sets stableTimeStep's
+  /// limit of `kind` (0 convection, 1 viscosity, 2 conduction); the same text on every rank.
+  std::string limitingCell(const CellState<Dim>& state, int m, int kind, double previous_dt) const;
   void applyPressureCorrection(CellState<Dim>& state, double dt);
   // Σ_m θ_m κ_m s'(κ_m Σδp) into mixture_compressibility_ where that is more than
   // kCompressibilityChange below it somewhere; returns whether it wrote (then reassemble).

@@ -385,14 +385,18 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
     std::ostringstream message;
     message << "step " << step + 1 << " from t = " << showNumber(t) << " s failed";
     if (retries > 0) message << " " << retries + 1 << " times, the last with dt = " << showNumber(dt) << " s";
-    message << ": " << failure << ". "
-            << (retries < scene.time.step_retries
-                    ? "Half that time step would be below time.dt_min (" + showNumber(scene.time.dt_min) + " s)"
-                    : "time.step_retries is " + std::to_string(scene.time.step_retries))
-            << ". The last good state, step " << step << " at t = " << showNumber(t) << " s, is in " << file
+    message << ": " << failure << ". ";
+    // retries < 0: the step was not tried (its stable time step is below time.dt_min).
+    if (retries >= 0)
+      message << (retries < scene.time.step_retries
+                      ? "Half that time step would be below time.dt_min (" + showNumber(scene.time.dt_min) + " s)"
+                      : "time.step_retries is " + std::to_string(scene.time.step_retries))
+              << ". ";
+    message << "The last good state, step " << step << " at t = " << showNumber(t) << " s, is in " << file
             << " and its checkpoint in "
             << checkpointDirectory(scene.output.directory) << "/ (cfdmpm --restart " << scene.output.directory
-            << " [scene.yaml] continues from it, e.g. with a smaller time.cfl or time.dt_max)";
+            << " [scene.yaml] continues from it, e.g. with a smaller "
+            << (retries < 0 ? "time.dt_min" : "time.cfl or time.dt_max") << ")";
     throw StepFailure(message.str());
   };
 
@@ -442,6 +446,14 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
       rebalance_first = false;
     }
     TimeStepLimit limit = run_state.step->stableTimeStep(*run_state.cells, clock.dt_previous);
+    if (limit.dt < scene.time.dt_min) {
+      // Run on at dt_min, such a state would take its steps without end (and unstably).
+      std::ostringstream reason;
+      reason << "its stable time step is " << showNumber(limit.dt) << " s (" << limit.limiter
+             << (limit.where.empty() ? "" : ", " + limit.where) << "), below time.dt_min ("
+             << showNumber(scene.time.dt_min) << " s)";
+      giveUp(reason.str(), -1, limit.dt);
+    }
     if (step == 0 && scene.time.dt_initial < limit.dt) limit = {scene.time.dt_initial, "dt_initial"};
     clock.dt_previous = limit.dt;
     double dt = limit.dt;

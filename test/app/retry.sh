@@ -80,6 +80,20 @@ PY
   code=$?
   [ "$code" = 0 ] || { fail "restart with retries: exit $code"; cat "$work/restart.log"; }
   grep -q "step 3 undone" "$work/restart.log" || fail "the restart did not retry step 3"
+
+  # 4. A stable time step below time.dt_min stops the run before the step (run on at dt_min, it
+  #    would take unstable steps, or hold the run at dt_min without end): time.dt_min 0.03 s above
+  #    the block's convective limit, 0.05 m / 2 m/s = 0.025 s, named with the block's first cell.
+  sed -e "s|OUTPUT|$work/floor|" -e "s|DT_INITIAL|0.03|" -e "s|RETRIES|3|" -e "s|dt_max: 0.1|dt_max: 0.1\n    dt_min: 0.03|" \
+    "$SOURCE_DIR/test/app/retry/moving-block.yaml" > "$work/floor.yaml"
+  "$MPIEXEC" -n "$ranks" "$CFDMPM" "$work/floor.yaml" > "$work/floor.log" 2> "$work/floor.err"
+  code=$?
+  [ "$code" = 1 ] || { fail "run below dt_min: exit $code, expected 1"; cat "$work/floor.log" "$work/floor.err"; }
+  echo "run below dt_min: exit $code: $(cat "$work/floor.err")"
+  for needle in "step 1 from t = 0 s failed: its stable time step is 0.025 s (convection(water), cell (4, 3), where water" \
+      "moves at (2, 1) m/s), below time.dt_min (0.03 s). The last good state, step 0"; do
+    grep -qF -- "$needle" "$work/floor.err" || fail "the message lacks '$needle'"
+  done
 elif [ "$mode" = undo ]; then
   scene=$2 end=$3 ranks=$4 undo=$5
   for run in A U; do

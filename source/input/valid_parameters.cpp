@@ -510,7 +510,7 @@ const std::vector<std::string>& outputFieldNames()
 {
   static const std::vector<std::string> names{
       "volume_fraction", "density", "velocity", "temperature", "pressure", "specific_volume",
-      "particle_velocity", "particle_stress", "plastic_strain", "particle_material"};
+      "particle_velocity", "particle_stress", "plastic_strain", "particle_volume", "particle_material"};
   return names;
 }
 

@@ -11,12 +11,13 @@ void StateOutput<Dim>::checkFields(const Scene& scene)
 {
   static const std::vector<std::string> written{"volume_fraction", "density", "velocity", "temperature",
                                                 "pressure", "specific_volume", "particle_velocity",
-                                                "particle_stress", "plastic_strain", "particle_material"};
+                                                "particle_stress", "plastic_strain", "particle_volume",
+                                                "particle_material"};
   for (const std::string& f : scene.output.fields)
     if (std::find(written.begin(), written.end(), f) == written.end())
       throw InputError("cfdmpm.output.fields: got '" + f + "'; this version writes volume_fraction, density, "
                        "velocity, temperature, pressure, specific_volume, particle_velocity, particle_stress, "
-                       "plastic_strain, particle_material");
+                       "plastic_strain, particle_volume, particle_material");
 }
 
 template <int Dim>
@@ -79,6 +80,7 @@ std::string StateOutput<Dim>::write(long long step, double time, const CellState
     if (wanted("particle_velocity")) hdf5_->writeParticleVector("velocity", particles->velocity.data(), n, Dim);
     if (wanted("particle_stress")) hdf5_->writeParticleVector("stress", particles->stress.data(), n, 9);
     if (wanted("plastic_strain")) hdf5_->writeParticleScalar("plastic_strain", particles->plastic_strain.data(), n);
+    if (wanted("particle_volume")) hdf5_->writeParticleScalar("volume", particles->volume.data(), n);
     if (wanted("particle_material")) {
       buffer_.assign(particles->material.begin(), particles->material.end());
       hdf5_->writeParticleScalar("material", buffer_.data(), n);

@@ -43,6 +43,12 @@ for path in steps:
         inside = np.all((p[:, 0] >= 0) & (p[:, 0] <= 0.4) & (p[:, 1] >= 0) & (p[:, 1] <= 0.15))
         check(inside, "%s: every particle inside the box" % os.path.basename(path))
         check(f["particles/stress"].shape == (int(expected), 9), "stress has 9 components")
+        volume = f["particles/volume"][...]
+        check(volume.shape == (int(expected),) and bool(np.all(np.isfinite(volume) & (volume > 0))),
+              "%s: every particle volume written, finite and positive" % os.path.basename(path))
+        if path == steps[0]:
+            # At rest the particles tile the column: their volumes sum to its area (round-off).
+            check(abs(volume.sum() - 0.01) <= 1e-12, "step 0: particle volumes sum to the column's area")
         ids = f["particles/id"][...]
         check(np.unique(ids).size == int(expected), "%s: every particle id written once" % os.path.basename(path))
         if path == steps[0]:

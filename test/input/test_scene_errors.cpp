@@ -434,7 +434,7 @@ TEST_F(SceneTest, UnknownOutputFieldListsAllowedOnes)
   const std::string message = errorOf(replaced(kFullScene, "fields: [velocity, pressure, particle_stress]", "fields: [velocity, presure]"));
   expectMentions(message, {"cfdmpm.output.fields", "got '[velocity, presure]'", "'presure' is not allowed",
                            "volume_fraction, density, velocity, temperature, pressure, specific_volume, "
-                           "particle_velocity, particle_stress, plastic_strain, particle_material"});
+                           "particle_velocity, particle_stress, plastic_strain, particle_volume, particle_material"});
 }
 
 TEST_F(SceneTest, OutputFieldListedTwiceIsRefused)

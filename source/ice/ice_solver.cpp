@@ -524,12 +524,13 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
             // (no root for it; its law's density is p ρ_c / p_c) kept a specific volume from near
             // 0 Pa, ~1e12 m³/kg, closed to θ = 1.28 after the advection, and the Lagrangian volume
             // change at p < 0 turned it to −4e69 (a Drucker-Prager column under water, 0.2 s).
-            const double floor =
-                eos[m].kind == ice::EosKind::LinearWater ? eos[m].linear_water.cavitationDensity(temperature[m]) : 0.0;
+            const double vapour = !(mass_density[m] > 0) && eos[m].kind == ice::EosKind::LinearWater
+                                      ? eos[m].linear_water.cavitationDensity(temperature[m])
+                                      : 0.0;  // ρ_c of a boiling liquid without mass
             if (kSolids && roles.lagrangian[m] && !(mass_density[m] > 0))
               v(c, m) = particle_volume(c, m);
-            else if (!(mass_density[m] > 0) && floor > 0 && !(r.density[m] > floor))
-              v(c, m) = 1.0 / floor;
+            else if (vapour > 0 && !(r.density[m] > vapour))
+              v(c, m) = 1.0 / vapour;
             else if (mass_density[m] > 0 || (r.density[m] > 0 && r.density[m] < DBL_MAX))
               v(c, m) = 1.0 / r.density[m];
             kappa(c, m) = r.compressibility[m] > 0 && r.compressibility[m] < DBL_MAX ? r.compressibility[m] : 0.0;
@@ -1227,13 +1228,16 @@ void IceSolver<Dim>::momentumSourcePhase(CellState<Dim>& state, double dt)
             // by its volume, its ~-1e5 Pa stopped a sand column collapsing in air after 17 mm
             // against the dry column's 90; test VoidInADilatingSandDoesNotPullOnIt, doc/mpmice.md).
             const auto acting = [&](LocalOrdinal cell) {
-              double fluid = 0, solid = 0;
-              for (int m = 0; m < nm; ++m) {
+              double solid = 0;
+              for (int m = 0; m < nm; ++m)
                 if (roles.reference_inside[m]) solid += theta(cell, m);
-                else if (!roles.lagrangian[m] && rho(cell, m) > 0)
+              // No such solid: the share below is 1, the cell's own pressure (in the same form).
+              if (!(solid > 0)) return p_ref(cell, 0) + (p(cell, 0) - p_ref(cell, 0));
+              double fluid = 0;
+              for (int m = 0; m < nm; ++m)
+                if (!roles.lagrangian[m] && rho(cell, m) > 0)
                   fluid += rho(cell, m) / eos[m].density(p_ref(cell, 0), T(cell, m));
-              }
-              const double share = fluid + solid > 0 ? fluid / (fluid + solid) : 1.0;
+              const double share = fluid / (fluid + solid);
               const double weight =
                   math::min(1.0, math::max(0.0, (share - kPoreShareLow) / (kPoreShareHigh - kPoreShareLow)));
               return p_ref(cell, 0) + weight * (p(cell, 0) - p_ref(cell, 0));
@@ -1887,6 +1891,28 @@ KOKKOS_INLINE_FUNCTION double othersShare(const Fractions& theta, LocalOrdinal c
     if (k != m) others += theta(c, k);
   return others;
 }
+// What material m in cell c limits stableTimeStep by (0 where it does not limit; it limits only where
+// present, θ > 1e-6): its convective rate max_d |u_d| / h_d ...
+template <int Dim, class Velocities, class Fractions>
+KOKKOS_INLINE_FUNCTION double convectiveRate(const Velocities& u, const Fractions& theta, const double* inv_h,
+                                             LocalOrdinal c, int m)
+{
+  if (theta(c, m) < 1e-6) return 0.0;
+  double rate = 0;
+  for (int d = 0; d < Dim; ++d) rate = math::max(rate, math::abs(u(c, m * Dim + d)) * inv_h[d]);
+  return rate;
+}
+// ... and its specific volume v, whose μ v and k v / c_v set the viscous and conduction limits, except
+// where the exchange holds it to the others of its cell within the step, Δt v K Σ_n θ_n > 1
+// (stableTimeStep).
+template <class Fractions, class Volumes>
+KOKKOS_INLINE_FUNCTION double diffusiveVolume(const Fractions& theta, const Volumes& v, double previous_dt, double K,
+                                              LocalOrdinal c, int m, int n)
+{
+  if (theta(c, m) < 1e-6) return 0.0;
+  if (previous_dt * v(c, m) * K * othersShare(theta, c, m, n) > 1.0) return 0.0;
+  return v(c, m);
+}
 
 template <int Dim>
 TimeStepLimit IceSolver<Dim>::stableTimeStep(const CellState<Dim>& state, double previous_dt) const
@@ -1909,9 +1935,7 @@ TimeStepLimit IceSolver<Dim>::stableTimeStep(const CellState<Dim>& state, double
     Kokkos::parallel_reduce(
         "ice::stableTimeStep", Kokkos::RangePolicy<ExecutionSpace>(0, state.velocity.ownedCount()),
         KOKKOS_LAMBDA(const LocalOrdinal c, double& worst) {
-          if (theta(c, m) < 1e-6) return;
-          double s = 0;
-          for (int d = 0; d < Dim; ++d) s = math::max(s, math::abs(u(c, m * Dim + d)) * inv_h[d]);
+          const double s = convectiveRate<Dim>(u, theta, inv_h, c, m);
           if (s > worst) worst = s;
         },
         Kokkos::Max<double>(rate));
@@ -1927,9 +1951,8 @@ TimeStepLimit IceSolver<Dim>::stableTimeStep(const CellState<Dim>& state, double
     Kokkos::parallel_reduce(
         "ice::viscousLimit", Kokkos::RangePolicy<ExecutionSpace>(0, state.velocity.ownedCount()),
         KOKKOS_LAMBDA(const LocalOrdinal c, double& worst) {
-          if (theta(c, m) < 1e-6) return;
-          if (previous_dt * v(c, m) * K * othersShare(theta, c, m, n) > 1.0) return;
-          if (v(c, m) > worst) worst = v(c, m);
+          const double volume = diffusiveVolume(theta, v, previous_dt, K, c, m, n);
+          if (volume > worst) worst = volume;
         },
         Kokkos::Max<double>(max_nu));
     local[3 * m] = rate > 0 ? cfl / rate : DBL_MAX;
@@ -1941,23 +1964,21 @@ TimeStepLimit IceSolver<Dim>::stableTimeStep(const CellState<Dim>& state, double
   }
   Teuchos::reduceAll(*layout_->comm(), Teuchos::REDUCE_MIN, 3 * n, local.data(), global.data());
   TimeStepLimit limit{scene_.time.dt_max, "dt_max"};
-  for (int m = 0; m < n; ++m) {
-    if (global[3 * m] < limit.dt) limit = {global[3 * m], "convection(" + names_[m] + ")"};
-    if (global[3 * m + 1] < limit.dt) limit = {global[3 * m + 1], "viscosity(" + names_[m] + ")"};
-    if (global[3 * m + 2] < limit.dt) limit = {global[3 * m + 2], "conduction(" + names_[m] + ")"};
-  }
-  if (previous_dt > 0 && settings_.dt_growth * previous_dt < limit.dt)
+  static const char* const kinds[3] = {"convection(", "viscosity(", "conduction("};
+  int limiting = -1;  // the material's 3 m + kind that sets the limit, if one does
+  for (int m = 0; m < n; ++m)
+    for (int kind = 0; kind < 3; ++kind)
+      if (global[3 * m + kind] < limit.dt) {
+        limit = {global[3 * m + kind], kinds[kind] + names_[m] + ")"};
+        limiting = 3 * m + kind;
+      }
+  if (previous_dt > 0 && settings_.dt_growth * previous_dt < limit.dt) {
     limit = {settings_.dt_growth * previous_dt, "growth"};
-  // Below time.dt_min the run cannot go on (the driver stops it): say which cell sets the limit.
-  if (limit.dt < scene_.time.dt_min) {
-    for (int m = 0; m < n; ++m) {
-      const int kind = limit.limiter == "convection(" + names_[m] + ")"  ? 0
-                       : limit.limiter == "viscosity(" + names_[m] + ")" ? 1
-                       : limit.limiter == "conduction(" + names_[m] + ")" ? 2
-                                                                          : -1;
-      if (kind >= 0) limit.where = limitingCell(state, m, kind, previous_dt);
-    }
+    limiting = -1;
   }
+  // Below time.dt_min the run cannot go on (the driver stops it): say which cell sets the limit.
+  if (limit.dt < scene_.time.dt_min && limiting >= 0)
+    limit.where = limitingCell(state, limiting / 3, limiting % 3, previous_dt);
   return limit;
 }
 
@@ -1980,13 +2001,8 @@ std::string IceSolver<Dim>::limitingCell(const CellState<Dim>& state, int m, int
   Kokkos::parallel_reduce(
       "ice::limitingCell", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
       KOKKOS_LAMBDA(const LocalOrdinal c, typename Location::value_type& best) {
-        if (theta(c, m) < 1e-6) return;
-        double a = 0;
-        if (kind == 0) {
-          for (int d = 0; d < Dim; ++d) a = math::max(a, math::abs(u(c, m * Dim + d)) * inv_h[d]);
-        } else if (!(previous_dt * v(c, m) * K * othersShare(theta, c, m, n) > 1.0)) {
-          a = v(c, m);
-        }
+        const double a = kind == 0 ? convectiveRate<Dim>(u, theta, inv_h, c, m)
+                                   : diffusiveVolume(theta, v, previous_dt, K, c, m, n);
         if (a > best.val) best.val = a, best.loc = c;
       },
       Location(local));

@@ -9,15 +9,14 @@ namespace cfdmpm {
 template <int Dim>
 void StateOutput<Dim>::checkFields(const Scene& scene)
 {
-  static const std::vector<std::string> written{"volume_fraction", "density", "velocity", "temperature",
-                                                "pressure", "specific_volume", "particle_velocity",
-                                                "particle_stress", "plastic_strain", "particle_volume",
-                                                "particle_material"};
+  // write() below writes each of these (the names the input accepts).
+  const std::vector<std::string>& written = outputFieldNames();
   for (const std::string& f : scene.output.fields)
-    if (std::find(written.begin(), written.end(), f) == written.end())
-      throw InputError("cfdmpm.output.fields: got '" + f + "'; this version writes volume_fraction, density, "
-                       "velocity, temperature, pressure, specific_volume, particle_velocity, particle_stress, "
-                       "plastic_strain, particle_volume, particle_material");
+    if (std::find(written.begin(), written.end(), f) == written.end()) {
+      std::string names;
+      for (const std::string& name : written) names += (names.empty() ? "" : ", ") + name;
+      throw InputError("cfdmpm.output.fields: got '" + f + "'; this version writes " + names);
+    }
 }
 
 template <int Dim>

@@ -810,7 +810,7 @@ TEST(IceScenes, TraceOfBoilingWaterInAStretchedSolidKeepsASpecificVolume)
   EXPECT_NEAR(p, SoftSandCells::kP0 + 1.0e7 * std::log(cover), 0.01 * 1.0e7 * std::abs(std::log(cover)));
   const double vapour = 1.0 / boilingWater().cavitationDensity(293.15);
   // The trace's specific volume over the stretched column's cells (the water beside it may boil).
-  const auto largestWaterVolume = [&] {
+  const auto traceVolumeRange = [&] {
     const auto v = cells.state.specific_volume.view();
     const auto ijk = cells.layout->cellIndex();
     double largest = 0, smallest = INFINITY;
@@ -821,7 +821,7 @@ TEST(IceScenes, TraceOfBoilingWaterInAStretchedSolidKeepsASpecificVolume)
     }
     return std::make_pair(-globalMax(*cells.layout->comm(), -smallest), globalMax(*cells.layout->comm(), largest));
   };
-  auto [smallest, largest] = largestWaterVolume();
+  auto [smallest, largest] = traceVolumeRange();
   EXPECT_GT(smallest, 0.0);
   EXPECT_LE(largest, vapour * (1.0 + 1e-12));
   const double dt = 1e-4;
@@ -829,7 +829,7 @@ TEST(IceScenes, TraceOfBoilingWaterInAStretchedSolidKeepsASpecificVolume)
   cells.solver.pressurePhase(cells.state, dt, report);
   cells.solver.momentumSourcePhase(cells.state, dt);
   cells.solver.exchangePhase(cells.state, dt, report);
-  std::tie(smallest, largest) = largestWaterVolume();
+  std::tie(smallest, largest) = traceVolumeRange();
   if (world()->getRank() == 0)
     std::cout << "stretched sand at " << p << " Pa; the trace's specific volume after a step: " << smallest << " .. "
               << largest << " m^3/kg (vapour at p_c: " << vapour << ")\n";

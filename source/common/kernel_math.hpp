@@ -18,6 +18,7 @@ namespace cfdmpm::math {
 KOKKOS_INLINE_FUNCTION double sqrt(double x) { return CFDMPM_KOKKOS_MATH::sqrt(x); }
 KOKKOS_INLINE_FUNCTION double cbrt(double x) { return CFDMPM_KOKKOS_MATH::cbrt(x); }
 KOKKOS_INLINE_FUNCTION double floor(double x) { return CFDMPM_KOKKOS_MATH::floor(x); }
+KOKKOS_INLINE_FUNCTION double exp(double x) { return CFDMPM_KOKKOS_MATH::exp(x); }
 KOKKOS_INLINE_FUNCTION double abs(double x) { return CFDMPM_KOKKOS_MATH::fabs(x); }
 #undef CFDMPM_KOKKOS_MATH
 KOKKOS_INLINE_FUNCTION double max(double a, double b) { return a > b ? a : b; }

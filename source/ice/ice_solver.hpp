@@ -171,7 +171,8 @@ class IceSolver {
   static constexpr double kPressureRowsGain = 0.02;
   /// The pressure about which the solids' equation of state is taken in each cell (the pore pressure
   /// of still fluid there; default: initial_state.pressure everywhere). The coupled step sets it to
-  /// the initial state's pressure, the hydrostatic pressure of the fluids that the solids displace.
+  /// the initial state's pressure, the hydrostatic pressure of the fluids that the solids displace;
+  /// each step adds the fluids' uniform change since then (updateReferenceShift).
   void setSolidReferencePressure(const Field<Dim>& pressure);
   /// The solids' reference pressure per cell (Pa), set once at the start of a run; a checkpoint
   /// keeps it.
@@ -243,6 +244,9 @@ class IceSolver {
   double phaseSeconds(const std::string& phase) const { return timers_.at(phase)->totalElapsedTime(); }
 
  private:
+  /// reference_shift_ from the state's pressure: the volume mean of p − p_ref over the cells that
+  /// hold fluids alone (over all ranks).
+  void updateReferenceShift(const CellState<Dim>& state);
   void faceVelocities(const CellState<Dim>& state, double dt);
   double pressureRightHandSide(CellState<Dim>& state, double dt, bool after_solve);
   /// "cell (i, j): ..." for the cell whose weighted volume residual (the outer test's) is the
@@ -327,6 +331,7 @@ class IceSolver {
   Field<Dim> filter_laplacian_, filter_increment_;  // filterOddEven's work space (1 column when off)
   Field<Dim> old_specific_volume_;      // v before the Lagrangian update (for the p dv work)
   Field<Dim> solid_reference_pressure_; // p_ref of the solids' equation of state per cell (Pa)
+  double reference_shift_ = 0;          // the fluids' uniform pressure change added to it (updateReferenceShift)
   Field<Dim> solid_particle_volume_;    // a solid's specific volume as its particles hold it (m^3/kg)
   std::unique_ptr<PressureSolver<Dim>> pressure_solver_;
   std::unique_ptr<Advector<Dim>> advector_;

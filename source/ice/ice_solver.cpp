@@ -1543,6 +1543,7 @@ void IceSolver<Dim>::equilibrationPhase(CellState<Dim>& state, IceStepReport& re
   Teuchos::TimeMonitor phase(*timers_.at("equilibration"));
   markClosedCells(state);
   if (roles_.any_solid) updateReferenceShift(state);
+  report.reference_shift = reference_shift_;
   Kokkos::deep_copy(delta_p_.view(), state.pressure.view());  // the previous step's pressure (δp is reset before use)
   report.equilibration_failures = equilibrate(state);
   report.first_failed_equilibration = first_failed_equilibration_;

@@ -68,6 +68,9 @@ struct IceStepReport {
   // a jump is a volume that arrived unforeseen (by advection or by the particles) divided by the
   // cell's compressibility Σθκ.
   double equilibration_jump = 0;
+  // With solids: the fluids' uniform pressure change since the initial state that the solids'
+  // reference pressure follows this step (Pa; IceSolver::updateReferenceShift).
+  double reference_shift = 0;
   int exchange_failures = 0;      // cells or faces whose exchange gave a value that is not finite
   long long first_failed_cell = -1;  // global id of the lowest such cell (either kind), or -1
   double max_outflux_fraction = 0;

@@ -205,6 +205,7 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
     // With particles, the solids' columns are theirs (exact masses), not the cells'.
     for (const std::string& c : conservedColumns<Dim>(scene, has_particles)) physics_columns.push_back(c);
     physics_columns.insert(physics_columns.end(), {"equilibration_failures", "equilibration_jump", "exchange_failures", "pressure_converged"});
+    if (has_particles) physics_columns.push_back("reference_shift");
   }
   if (has_particles) {
     if (fluids_move) physics_columns.push_back("particle_steps");
@@ -225,6 +226,7 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
           for (int k = 0; k < Dim + 2; ++k) row.emplace_back(sums[m * (Dim + 2) + k]);
       row.insert(row.end(), {CsvValue(r.equilibration_failures), CsvValue(r.equilibration_jump), CsvValue(r.exchange_failures),
                              CsvValue(r.converged ? 1 : 0)});
+      if (has_particles) row.emplace_back(r.reference_shift);
     }
     if (const mpm::MpmSolver<Dim>* particles = run_state.step->particles()) {
       if (fluids_move) row.emplace_back(step_report.particle_steps);

@@ -69,12 +69,16 @@ bool namesCellOrParticle(const std::string& failure)
   return failure.find("cell (") != std::string::npos || failure.find("particle") != std::string::npos;
 }
 
-// A run holds when it does not stop and the velocity's departure from uniform acceleration does not
-// grow over the window: the staggered step multiplies an acceleration error by ρw / ρs per step,
-// so below ρs = ρw it grows by orders of magnitude within the window's ~1000 steps, while a stable
-// run's departure (the start-up's pressure waves, the disk's elastic ringing) stays or decays.
-// Bound: growth ≤ 2 between the window's halves.
+// A run holds when it does not stop, the velocity's departure from uniform acceleration does not
+// grow over the window, and it stays below the speed the disk reaches: the staggered step
+// multiplies an acceleration error by ρw / ρs per step, so below ρs = ρw it grows by orders of
+// magnitude within the window's ~1000 steps, while a stable run's departure (the start-up's
+// pressure waves, the disk's elastic ringing) stays or decays, at 1e-3 .. 2e-2 of that speed.
+// Bounds: growth ≤ 2 between the window's halves; oscillation ≤ 1 (an instability that has grown
+// to its full size within the first half no longer grows: the staggered 100 kg/m³ disk at c20a984
+// departed by 22.7 times its speed with a growth of 0.97).
 constexpr double kGrowthBound = 2.0;
+constexpr double kOscillationBound = 1.0;
 
 TEST(StabilityAddedMass, LightDiskMonolithicHoldsStaggeredFails)
 {
@@ -84,13 +88,13 @@ TEST(StabilityAddedMass, LightDiskMonolithicHoldsStaggeredFails)
     const double ratio = density / 1000.0;
     for (const std::string coupling : {"monolithic", "staggered"}) {
       const DiskOutcome d = runDisk(density, coupling);
-      const bool holds = d.failure.empty() && d.growth <= kGrowthBound;
+      const bool holds = d.failure.empty() && d.growth <= kGrowthBound && d.oscillation <= kOscillationBound;
       report(density, coupling, d);
       const double error = d.failure.empty() ? std::abs(d.ratio - 1.0) + d.oscillation : 10.0;
       rows.push_back({ratio, error, coupling == "monolithic" ? "monolithic (cfdmpm)" : "staggered",
                       holds ? "ok" : "failed"});
       if (coupling == "monolithic") {
-        EXPECT_TRUE(holds) << density << ": growth " << d.growth << " " << d.failure;
+        EXPECT_TRUE(holds) << density << ": growth " << d.growth << ", oscillation " << d.oscillation << " " << d.failure;
         // The 10 % on the acceleration holds for the disks heavier than a fifth of the
         // water (test_coupled's bound); the lighter disks' is reported (doc/stability.md, case b):
         // at 20 cells per diameter the 100 kg/m³ disk slows as its top crosses a face and the
@@ -103,7 +107,7 @@ TEST(StabilityAddedMass, LightDiskMonolithicHoldsStaggeredFails)
         if (!holds && staggered_fails_below == 0) staggered_fails_below = ratio;
         // The staggered step holds for the heavy disk and fails for every disk lighter than the water.
         if (ratio > 1.0) {
-          EXPECT_TRUE(holds) << density << ": growth " << d.growth << " " << d.failure;
+          EXPECT_TRUE(holds) << density << ": growth " << d.growth << ", oscillation " << d.oscillation << " " << d.failure;
         } else {
           EXPECT_FALSE(holds) << density;
         }

@@ -955,8 +955,8 @@ namespace {
 // that the fluid around it fills: the solid is drained, and its grains with the pore fluid they held
 // before take no more of the cell than that. Counted as solid, the dilation pushed the fluid out of
 // the cells instead: a Drucker-Prager column collapsing under water swelled by 49 % in 0.4 s, single
-// particles at its surface to 23 times their volume (doc/mpmice.md, "A granular solid's dilation").
-// Zero for every other model (ε^p_v stays 0): their V_p.
+// particles at its surface to 23 times their volume (doc/mpmice.md, "A granular solid's plastic
+// dilation is the fluids' volume"). Every other model keeps ε^p_v = 0: the fluids see its V_p.
 KOKKOS_INLINE_FUNCTION double fluidsVolume(double volume, const MaterialState& state)
 {
   return state.volumetric_plastic_strain == 0.0 ? volume : volume * math::exp(-state.volumetric_plastic_strain);

@@ -178,6 +178,21 @@ KOKKOS_INLINE_FUNCTION bool shutFace(const Mask& closed, LocalOrdinal c, LocalOr
   return closed(c) || (l >= 0 && closed(l));
 }
 
+// An owned cell no solid reaches on any of its faces (IceSolver::markSolidCells: neither it, which
+// holds its lower faces, nor an upper neighbour, which holds its upper faces, is marked). Without a
+// mask (a scene without solids never marks one) no cell is quiet.
+template <class Mask, class Neighbours>
+KOKKOS_INLINE_FUNCTION bool quietCell(const Mask& solid_cells, const Neighbours& neighbours, LocalOrdinal c)
+{
+  if (solid_cells.extent(0) == 0) return false;
+  if (solid_cells(c)) return false;
+  for (int f = 1; f < int(neighbours.extent(1)); f += 2) {
+    const LocalOrdinal r = neighbours(c, f);
+    if (r >= 0 && solid_cells(r)) return false;
+  }
+  return true;
+}
+
 // Whether cell c is closed and every face neighbour it has is closed too (domain walls count as
 // closed): such a cell has no row in the pressure matrix (IceSolver::updatePressureRows).
 template <int Dim, class Mask, class Neighbours>
@@ -702,6 +717,44 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
   if (with_solids) solid_kinematic_velocity_.exchangeHalo();
 }
 
+// [5] The cells (owned and ghost) where a solid is or reaches: a solid's mass, volume fraction, or
+// share or cover of one of the cell's lower faces (the faces stored at the cell) is not zero. On a
+// face between two cells outside the mask no solid lies on either side, and the pressure phase's
+// face kernels take the fluids' short path there, with the values their general path gives when
+// every solid term is zero: the solids cover a few per cent of the seed scene's open cells, and the
+// general path reads all of their columns on every face, which the kernels' memory traffic
+// follows. A solid's face velocity is then left at zero there (no share of the face carries it).
+// Marked once per pressure phase: nothing in it moves a solid.
+template <int Dim>
+void IceSolver<Dim>::markSolidCells(const CellState<Dim>& state)
+{
+  if (solid_cells_.extent(0) != std::size_t(layout_->overlapCells()))
+    solid_cells_ = CellMask("solid cells", layout_->overlapCells());
+  const int n = materials_;
+  const auto roles = roles_;
+  const auto theta = state.volume_fraction.view();
+  const auto rho = state.density.view();
+  typename Field<Dim>::ConstView share[3], cover[3];
+  for (int d = 0; d < Dim; ++d) {
+    share[d] = solid_face_share_.direction(d).view();
+    cover[d] = solid_face_cover_.direction(d).view();
+  }
+  auto marked = solid_cells_;
+  Kokkos::parallel_for(
+      "ice::markSolidCells", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->overlapCells()),
+      KOKKOS_LAMBDA(const LocalOrdinal c) {
+        bool solid = false;  // a NaN is not zero: it takes the general path, which reports it
+        for (int m = 0; m < n && !solid; ++m) {
+          if (!roles.lagrangian[m] && !roles.rigid[m]) continue;
+          solid = theta(c, m) != 0.0 || rho(c, m) != 0.0;
+          for (int d = 0; d < Dim && !solid; ++d)
+            for (int side = 0; side < 2; ++side)
+              solid = solid || share[d](c, 2 * m + side) != 0.0 || cover[d](c, 2 * m + side) != 0.0;
+        }
+        marked(c) = solid ? 1 : 0;
+      });
+}
+
 // [5] With solids in the cells, the volume fraction of each fluid that crosses each face: the
 // advection's own mass profile in the donor's slab (Advector::slabDensities, for the face velocities
 // before the correction) times the donor's specific volume. The upwind cell's volume fraction would
@@ -722,6 +775,7 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
   const auto roles = roles_;
   const auto closed = closed_;
   auto leaves = fluid_outflow_share_;
+  const auto solid_cells = solid_cells_;
   for (int d = 0; d < Dim; ++d) {
     auto out = fluid_face_fraction_.direction(d).view();
     const auto share = solid_face_share_.direction(d).view();
@@ -736,6 +790,27 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
             for (int m = 0; m < n; ++m) out(c, 2 * m) = out(c, 2 * m + 1) = 0.0;
             if (l >= 0) leaves(l, 2 * d + 1) = 1.0;
             leaves(c, 2 * d) = 1.0;
+            return;
+          }
+          if (!solid_cells(c) && (l < 0 || !solid_cells(l))) {
+            // No solid on either side (markSolidCells): the room is the whole face, and the fluids
+            // keep their profiles unless these hold more than the face.
+            double fluid[2] = {0, 0};
+            for (int m = 0; m < n; ++m) {
+              if (roles.lagrangian[m] || roles.rigid[m]) continue;
+              const double below = l >= 0 ? slab(l, 2 * d + 1, m) * v(l, m) : theta(c, m);
+              const double above = slab(c, 2 * d, m) * v(c, m);
+              out(c, 2 * m) = below, out(c, 2 * m + 1) = above;
+              fluid[0] += below, fluid[1] += above;
+            }
+            const double keep[2] = {fluid[0] > 0 && fluid[0] > 1.0 ? 1.0 / fluid[0] : 1.0,
+                                    fluid[1] > 0 && fluid[1] > 1.0 ? 1.0 / fluid[1] : 1.0};
+            if (keep[0] != 1.0 || keep[1] != 1.0)
+              for (int m = 0; m < n; ++m)
+                if (!roles.lagrangian[m] && !roles.rigid[m])
+                  for (int side = 0; side < 2; ++side) out(c, 2 * m + side) *= keep[side];
+            if (l >= 0) leaves(l, 2 * d + 1) = keep[0];
+            leaves(c, 2 * d) = keep[1];
             return;
           }
           // A solid's columns of `out` stay as constructed, zero: nothing reads them (a solid's
@@ -883,6 +958,7 @@ void IceSolver<Dim>::carriedFaceBeta(int outer_iteration)
   // needs 4-6 outer iterations per step on the seed scene instead of 6-10.
   const bool solid_faces = !solid_volume_predictor_;
   const auto closed = closed_;
+  const auto solid_cells = solid_cells_;
   for (int d = 0; d < Dim; ++d) {
     const auto vf = face_specific_volume_.direction(d).view();
     const auto fluid = fluid_face_fraction_.direction(d).view();
@@ -899,10 +975,11 @@ void IceSolver<Dim>::carriedFaceBeta(int outer_iteration)
             return;
           }
           double b = 0;
+          const bool solid_share = solid_faces && solid_cells(c);  // else no solid's share (markSolidCells)
           for (int m = 0; m < n; ++m) {
             if (roles.rigid[m]) continue;
             const bool solid = roles.lagrangian[m];
-            if (solid && !solid_faces) continue;
+            if (solid && !solid_share) continue;
             const double below = solid ? math::min(1.0, share(c, 2 * m)) : fluid(c, 2 * m);
             const double above = solid ? math::min(1.0, share(c, 2 * m + 1)) : fluid(c, 2 * m + 1);
             const double w = uf(c, m);
@@ -956,6 +1033,7 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
   // The solids' volume change from their particles (setSolidVolumePredictor): no face terms.
   const bool solid_faces = !solid_volume_predictor_;
   const auto closed = closed_;
+  const auto solid_cells = solid_cells_;
   for (int d = 0; d < Dim; ++d) {
     share[d] = solid_face_share_.direction(d).view();
     fluid[d] = fluid_face_fraction_.direction(d).view();
@@ -988,6 +1066,7 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
             sum_dp(c, 0) += dp(c, 0);
             p(c, 0) = p_eq(c, 0) + sum_dp(c, 0);
           }
+          const bool fluids_only = quietCell(solid_cells, neighbours, c);  // no solid on any face
           // Velocity of material m on the lower face of cell `upper` in direction d (below it:
           // cell `lower`), corrected with this iteration's δp when kCorrect.
           const auto faceVelocity = [&](int d, int m, LocalOrdinal upper, LocalOrdinal lower) {
@@ -1014,6 +1093,10 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
           for (int d = 0; d < Dim; ++d) {
             const LocalOrdinal l = neighbours(c, 2 * d), r = neighbours(c, 2 * d + 1);
             for (int m = 0; m < nm; ++m) {
+              if (fluids_only && (roles.rigid[m] || roles.lagrangian[m])) {
+                if (kCorrect) corrected[d](c, m) = 0.0;  // (markSolidCells)
+                continue;
+              }
               if (roles.rigid[m]) {
                 // Its face velocity is its own motion and takes no correction (v_f = 0,
                 // faceVelocities): it carries nothing beyond solidVolumeChange.
@@ -1034,12 +1117,13 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
             }
           }
           double solid_change = 0;  // Σ_solids Δθ of the particles' own motion
-          if (roles.any_solid)
+          if (roles.any_solid && !fluids_only)
             for (int m = 0; m < nm; ++m)
               if (roles.lagrangian[m]) solid_change += solid_change_view(c, m);
           double compression = 0;  // Σ_m θ_m s(κ_m Σδp): the share of the cell the pressure change takes
           double softness = 0;     // its slope, Σ_m θ_m s'(κ_m Σδp), a boiling liquid's as the liquid's
           for (int m = 0; m < nm; ++m) {
+            if (fluids_only && (roles.rigid[m] || roles.lagrangian[m])) continue;  // θ_m = 0
             compression += theta(c, m) * materialVolumeLoss(eos[m], p_eq(c, 0), T(c, m), kappa(c, m), sum_dp(c, 0));
             softness += cavitating(eos[m], p_eq(c, 0))
                             ? theta(c, m) * stiffest
@@ -1060,7 +1144,8 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
           // still surface). A boiling liquid counts as the liquid (its vapour's slope is not what
           // a surplus meets), and a cell stiffer than the stiffest fluid keeps its volume residual.
           double cell_density = 0;
-          for (int m = 0; m < nm; ++m) cell_density += mass_density(c, m);
+          for (int m = 0; m < nm; ++m)
+            if (!fluids_only || !(roles.rigid[m] || roles.lagrangian[m])) cell_density += mass_density(c, m);
           const double weight = (softness > stiffest ? stiffest / softness : 1.0) *
                                 (cell_density > 0 && cell_density < stiffest_density ? stiffest_density / cell_density : 1.0);
           outer_weight(c, 0) = weight;
@@ -1108,6 +1193,7 @@ void IceSolver<Dim>::applyPressureCorrection(CellState<Dim>& state, double dt)
   }
   const auto roles = faceRoles();
   const auto closed = closed_;
+  const auto solid_cells = solid_cells_;
   forMaterialCount(n, [&](auto count) {
     constexpr int N = decltype(count)::value;
     Kokkos::parallel_for(
@@ -1119,9 +1205,14 @@ void IceSolver<Dim>::applyPressureCorrection(CellState<Dim>& state, double dt)
             sum_dp(c, 0) += dp(c, 0);
             p(c, 0) = p_eq(c, 0) + sum_dp(c, 0);
           }
+          const bool fluids_only = quietCell(solid_cells, neighbours, c);
           for (int d = 0; d < Dim; ++d) {
             const LocalOrdinal l = neighbours(c, 2 * d);
             for (int m = 0; m < nm; ++m) {
+              if (fluids_only && (roles.rigid[m] || roles.lagrangian[m])) {  // as pressureRightHandSide
+                corrected[d](c, m) = 0.0;
+                continue;
+              }
               const double w = uf[d](c, m);
               corrected[d](c, m) = wall_cell || roles.rigid[m] || l < 0 ? w : w - dt_per_h[d] * vf[d](c, m) * (dp(c, 0) - dp(l, 0));
             }
@@ -1613,6 +1704,7 @@ void IceSolver<Dim>::pressurePhase(CellState<Dim>& state, double dt, IceStepRepo
   sum_delta_p_.fill(0.0);
   const bool implicit = settings_.pressure == "implicit";
   if (roles_.any_solid) {
+    markSolidCells(state);
     fluidFaceFractions(state, dt);
     carriedFaceBeta(1);
   }

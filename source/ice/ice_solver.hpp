@@ -265,6 +265,7 @@ class IceSolver {
   void secantSlopeWhereBoiling(const CellState<Dim>& state);
   void updatePressureRows();
   void fluidFaceFractions(const CellState<Dim>& state, double dt);
+  void markSolidCells(const CellState<Dim>& state);
   void energy(CellState<Dim>& state, const Field<Dim>& old_specific_volume, double dt);
 
   Scene scene_;
@@ -276,6 +277,7 @@ class IceSolver {
   bool any_rigid_ = false;  // some material is a rigid solid: cells may be closed
   CellMask closed_;         // closedCells()
   CellMask without_row_;    // cellsWithoutPressureRow()
+  CellMask solid_cells_;    // markSolidCells()
   long long closed_count_ = 0;
   std::function<void(CellState<Dim>&, double)> solid_volume_predictor_;  // setSolidVolumePredictor
   /// The roles of the face phases (face velocities and exchange, the pressure equation): roles_,

@@ -179,18 +179,12 @@ KOKKOS_INLINE_FUNCTION bool shutFace(const Mask& closed, LocalOrdinal c, LocalOr
 }
 
 // An owned cell no solid reaches on any of its faces (IceSolver::markSolidCells: neither it, which
-// holds its lower faces, nor an upper neighbour, which holds its upper faces, is marked). Without a
-// mask (a scene without solids never marks one) no cell is quiet.
-template <class Mask, class Neighbours>
-KOKKOS_INLINE_FUNCTION bool quietCell(const Mask& solid_cells, const Neighbours& neighbours, LocalOrdinal c)
+// holds its lower faces, nor an upper neighbour, which holds its upper faces, is marked). Without
+// the mask (a scene without solids never makes one) no cell is quiet.
+template <class Mask>
+KOKKOS_INLINE_FUNCTION bool quietCell(const Mask& quiet_cells, LocalOrdinal c)
 {
-  if (solid_cells.extent(0) == 0) return false;
-  if (solid_cells(c)) return false;
-  for (int f = 1; f < int(neighbours.extent(1)); f += 2) {
-    const LocalOrdinal r = neighbours(c, f);
-    if (r >= 0 && solid_cells(r)) return false;
-  }
-  return true;
+  return quiet_cells.extent(0) > 0 && quiet_cells(c);
 }
 
 // Whether cell c is closed and every face neighbour it has is closed too (domain walls count as
@@ -724,7 +718,11 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
 // every solid term is zero: the solids cover a few per cent of the seed scene's open cells, and the
 // general path reads all of their columns on every face, which the kernels' memory traffic
 // follows. A solid's face velocity is then left at zero there (no share of the face carries it).
-// Marked once per pressure phase: nothing in it moves a solid.
+// The owned cells none of whose faces a solid reaches (quietCell) are marked too, for the kernels
+// that visit a cell's faces together. Marked once per pressure phase: nothing in it moves a solid.
+// (The fluids' fractions on such faces stay the slab profile's: taken from the upwind cell, as
+// without solids, they switched with a solid's trace in a neighbouring cell, which round-off makes
+// on one decomposition and not on another; doc/mpmice.md, "Cost".)
 template <int Dim>
 void IceSolver<Dim>::markSolidCells(const CellState<Dim>& state)
 {
@@ -752,6 +750,20 @@ void IceSolver<Dim>::markSolidCells(const CellState<Dim>& state)
               solid = solid || share[d](c, 2 * m + side) != 0.0 || cover[d](c, 2 * m + side) != 0.0;
         }
         marked(c) = solid ? 1 : 0;
+      });
+  if (quiet_cells_.extent(0) != std::size_t(layout_->ownedCells()))
+    quiet_cells_ = CellMask("quiet cells", layout_->ownedCells());
+  auto quiet = quiet_cells_;
+  const auto neighbours = layout_->cellNeighbours();
+  Kokkos::parallel_for(
+      "ice::markQuietCells", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+      KOKKOS_LAMBDA(const LocalOrdinal c) {
+        bool none = !marked(c);
+        for (int d = 0; d < Dim; ++d) {
+          const LocalOrdinal r = neighbours(c, 2 * d + 1);
+          none = none && !(r >= 0 && marked(r));
+        }
+        quiet(c) = none ? 1 : 0;
       });
 }
 
@@ -1033,7 +1045,7 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
   // The solids' volume change from their particles (setSolidVolumePredictor): no face terms.
   const bool solid_faces = !solid_volume_predictor_;
   const auto closed = closed_;
-  const auto solid_cells = solid_cells_;
+  const auto quiet_cells = quiet_cells_;
   for (int d = 0; d < Dim; ++d) {
     share[d] = solid_face_share_.direction(d).view();
     fluid[d] = fluid_face_fraction_.direction(d).view();
@@ -1066,7 +1078,7 @@ double IceSolver<Dim>::pressureRightHandSide(CellState<Dim>& state, double dt, b
             sum_dp(c, 0) += dp(c, 0);
             p(c, 0) = p_eq(c, 0) + sum_dp(c, 0);
           }
-          const bool fluids_only = quietCell(solid_cells, neighbours, c);  // no solid on any face
+          const bool fluids_only = quietCell(quiet_cells, c);  // no solid on any face
           // Velocity of material m on the lower face of cell `upper` in direction d (below it:
           // cell `lower`), corrected with this iteration's δp when kCorrect.
           const auto faceVelocity = [&](int d, int m, LocalOrdinal upper, LocalOrdinal lower) {
@@ -1193,7 +1205,7 @@ void IceSolver<Dim>::applyPressureCorrection(CellState<Dim>& state, double dt)
   }
   const auto roles = faceRoles();
   const auto closed = closed_;
-  const auto solid_cells = solid_cells_;
+  const auto quiet_cells = quiet_cells_;
   forMaterialCount(n, [&](auto count) {
     constexpr int N = decltype(count)::value;
     Kokkos::parallel_for(
@@ -1205,14 +1217,21 @@ void IceSolver<Dim>::applyPressureCorrection(CellState<Dim>& state, double dt)
             sum_dp(c, 0) += dp(c, 0);
             p(c, 0) = p_eq(c, 0) + sum_dp(c, 0);
           }
-          const bool fluids_only = quietCell(solid_cells, neighbours, c);
+          if (quietCell(quiet_cells, c)) {  // as pressureRightHandSide: no solid's face velocity
+            for (int d = 0; d < Dim; ++d) {
+              const LocalOrdinal l = neighbours(c, 2 * d);
+              const bool still = wall_cell || l < 0;
+              const double jump = still ? 0.0 : dp(c, 0) - dp(l, 0);
+              for (int m = 0; m < nm; ++m)
+                corrected[d](c, m) = roles.rigid[m] || roles.lagrangian[m] ? 0.0
+                                     : still ? uf[d](c, m)
+                                             : uf[d](c, m) - dt_per_h[d] * vf[d](c, m) * jump;
+            }
+            return;
+          }
           for (int d = 0; d < Dim; ++d) {
             const LocalOrdinal l = neighbours(c, 2 * d);
             for (int m = 0; m < nm; ++m) {
-              if (fluids_only && (roles.rigid[m] || roles.lagrangian[m])) {  // as pressureRightHandSide
-                corrected[d](c, m) = 0.0;
-                continue;
-              }
               const double w = uf[d](c, m);
               corrected[d](c, m) = wall_cell || roles.rigid[m] || l < 0 ? w : w - dt_per_h[d] * vf[d](c, m) * (dp(c, 0) - dp(l, 0));
             }

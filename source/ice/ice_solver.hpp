@@ -277,7 +277,8 @@ class IceSolver {
   bool any_rigid_ = false;  // some material is a rigid solid: cells may be closed
   CellMask closed_;         // closedCells()
   CellMask without_row_;    // cellsWithoutPressureRow()
-  CellMask solid_cells_;    // markSolidCells()
+  CellMask solid_cells_;    // markSolidCells(): a solid is or reaches here (owned and ghost cells)
+  CellMask quiet_cells_;    // markSolidCells(): no solid reaches any face of the owned cell
   long long closed_count_ = 0;
   std::function<void(CellState<Dim>&, double)> solid_volume_predictor_;  // setSolidVolumePredictor
   /// The roles of the face phases (face velocities and exchange, the pressure equation): roles_,

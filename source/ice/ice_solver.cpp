@@ -804,35 +804,18 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
             leaves(c, 2 * d) = 1.0;
             return;
           }
-          if (!solid_cells(c) && (l < 0 || !solid_cells(l))) {
-            // No solid on either side (markSolidCells): the room is the whole face, and the fluids
-            // keep their profiles unless these hold more than the face.
-            double fluid[2] = {0, 0};
-            for (int m = 0; m < n; ++m) {
-              if (roles.lagrangian[m] || roles.rigid[m]) continue;
-              const double below = l >= 0 ? slab(l, 2 * d + 1, m) * v(l, m) : theta(c, m);
-              const double above = slab(c, 2 * d, m) * v(c, m);
-              out(c, 2 * m) = below, out(c, 2 * m + 1) = above;
-              fluid[0] += below, fluid[1] += above;
-            }
-            const double keep[2] = {fluid[0] > 0 && fluid[0] > 1.0 ? 1.0 / fluid[0] : 1.0,
-                                    fluid[1] > 0 && fluid[1] > 1.0 ? 1.0 / fluid[1] : 1.0};
-            if (keep[0] != 1.0 || keep[1] != 1.0)
-              for (int m = 0; m < n; ++m)
-                if (!roles.lagrangian[m] && !roles.rigid[m])
-                  for (int side = 0; side < 2; ++side) out(c, 2 * m + side) *= keep[side];
-            if (l >= 0) leaves(l, 2 * d + 1) = keep[0];
-            leaves(c, 2 * d) = keep[1];
-            return;
-          }
           // A solid's columns of `out` stay as constructed, zero: nothing reads them (a solid's
           // flux takes its share of the face), and leaving them unwritten spares the kernel, which
           // memory bounds, a quarter of its streams.
           double fluid[2] = {0, 0}, rigid[2] = {0, 0}, deformable[2] = {0, 0}, swept[2] = {0, 0};
           double profile[2][ice::kMaxMaterials];  // each fluid's profile on the face, per donor side
+          // Without a solid on either side (markSolidCells) their shares, covers and volumes are
+          // zero: left unread, the face is all room, and the fluids keep their profiles unless
+          // these hold more than the face.
+          const bool solids_here = solid_cells(c) || (l >= 0 && solid_cells(l));
           for (int m = 0; m < n; ++m) {
             if (roles.lagrangian[m] || roles.rigid[m]) {
-              for (int side = 0; side < 2; ++side) {
+              for (int side = 0; side < 2 && solids_here; ++side) {
                 (roles.rigid[m] ? rigid : deformable)[side] += math::min(1.0, share(c, 2 * m + side));
                 swept[side] += math::min(1.0, cover(c, 2 * m + side));
               }
@@ -914,7 +897,7 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
             const double room = closed < 1.0 ? 1.0 - closed : 0.0;
             const LocalOrdinal donor = side == 0 ? l : c;
             double donor_solid = 0;
-            if (donor >= 0)
+            if (donor >= 0 && solids_here)
               for (int m = 0; m < n; ++m)
                 if (roles.lagrangian[m] || roles.rigid[m]) donor_solid += theta(donor, m);
             const bool fill = donor_solid > kSolidPresent && fluid[side] > kFillMinimum;

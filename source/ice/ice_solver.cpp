@@ -178,13 +178,40 @@ KOKKOS_INLINE_FUNCTION bool shutFace(const Mask& closed, LocalOrdinal c, LocalOr
   return closed(c) || (l >= 0 && closed(l));
 }
 
-// An owned cell no solid reaches on any of its faces (IceSolver::markSolidCells: neither it, which
-// holds its lower faces, nor an upper neighbour, which holds its upper faces, is marked). Without
-// the mask (a scene without solids never makes one) no cell is quiet.
+// An owned cell that no solid reaches, nor any of its faces (IceSolver::markSolidCells: neither it
+// nor a face neighbour is marked). Without the mask (a scene without solids never makes one) no
+// cell is quiet.
 template <class Mask>
 KOKKOS_INLINE_FUNCTION bool quietCell(const Mask& quiet_cells, LocalOrdinal c)
 {
   return quiet_cells.extent(0) > 0 && quiet_cells(c);
+}
+
+// What the materials on a face move with where one of them is absent on both sides (faceVelocities):
+// the mean of the others' face velocities and specific volumes weighted by (θ_L + θ_R) / v_f, and
+// β = Σ_m ½ (f_L + f_R) v_f with each material's shares f of the face. Materials `skip` says (the
+// rigid ones) take no part.
+struct FaceMixture {
+  double velocity, specific_volume, beta;
+};
+template <class Skip>
+KOKKOS_INLINE_FUNCTION FaceMixture faceMixture(int count, const ice::MaterialArray<double>& theta_left,
+                                               const ice::MaterialArray<double>& theta_right,
+                                               const ice::MaterialArray<double>& share_left,
+                                               const ice::MaterialArray<double>& share_right,
+                                               const ice::MaterialArray<double>& velocity,
+                                               const ice::MaterialArray<double>& specific_volume, const Skip& skip)
+{
+  double b = 0, weight = 0, momentum = 0, volume = 0;
+  for (int m = 0; m < count; ++m) {
+    if (skip(m)) continue;
+    const double w = (theta_left[m] + theta_right[m]) / specific_volume[m];
+    weight += w;
+    momentum += w * velocity[m];
+    volume += w * specific_volume[m];
+    b += 0.5 * (share_left[m] + share_right[m]) * specific_volume[m];
+  }
+  return {momentum / (weight + kTiny), weight > 0 ? volume / weight : b, b};
 }
 
 // Whether cell c is closed and every face neighbour it has is closed too (domain walls count as
@@ -478,6 +505,12 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
   Kokkos::View<long long, MemorySpace> first("first failed cell");
   Kokkos::deep_copy(first, std::numeric_limits<long long>::max());
   int failures = 0;
+  ice::MaterialArray<int> fluid{};
+  int fluids = 0;
+  for (int m = 0; m < n; ++m)
+    if (!roles_.lagrangian[m]) fluid[fluids++] = m;
+  const bool fluids_alone = fluids > 0 && solid_cells_.extent(0) > 0;
+  const auto solid_cells = solid_cells_;
   const auto kernel = [&](auto count, auto with_solids) {
     constexpr int N = decltype(count)::value;
     constexpr bool kSolids = decltype(with_solids)::value;
@@ -493,23 +526,59 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
           }
           ice::EquilibrationResult r;
           if constexpr (kSolids) {
-            // A trace of a material (less than kNegligibleMassShare of the cell's mass: e.g. air
-            // advected to a denormal density into a cell that sand and water fill) cannot fill the
-            // room that the others leave; it takes no part in the root (it would drive p to 0).
-            double cell_mass = 0;
-            for (int m = 0; m < nm; ++m) cell_mass += mass_density[m];
-            for (int m = 0; m < nm; ++m)
-              if (!(mass_density[m] > kNegligibleMassShare * cell_mass)) mass_density[m] = 0.0;
-            ice::MaterialArray<ice::Eos> local = eos;
-            for (int m = 0; m < nm; ++m) {
-              if (!roles.lagrangian[m]) continue;
-              const bool present = mass_density[m] > 0 && theta(c, m) > 0;
-              if (present) local[m] = ice::SolidEos(bulk[m], mass_density[m] / theta(c, m), p_ref(c, 0) + shift);
-              // The particles' own specific volume, before the equilibration compresses the solid's
-              // share (faceVelocities); where the solid is absent or a trace, its material's.
-              particle_volume(c, m) = present ? theta(c, m) / mass_density[m] : 1.0 / eos[m].solid.reference_density;
+            if (fluids_alone && !solid_cells(c)) {
+              // No solid here (markSolidCells): the fluids' root alone, which is the general one to
+              // the bit (materials without mass take no part in it, ice/equilibration.hpp), and the
+              // solids' columns as the general path sets those of an absent solid.
+              ice::MaterialArray<ice::Eos> fluid_eos;
+              ice::MaterialArray<double> fluid_mass{}, fluid_temperature{};
+              double cell_mass = 0;
+              for (int a = 0; a < fluids; ++a) cell_mass += mass_density[fluid[a]];
+              for (int a = 0; a < fluids; ++a) {
+                const int m = fluid[a];
+                fluid_eos[a] = eos[m];
+                fluid_mass[a] = mass_density[m] > kNegligibleMassShare * cell_mass ? mass_density[m] : 0.0;
+                fluid_temperature[a] = temperature[m];
+              }
+              const ice::EquilibrationResult f =
+                  fluids == 2 ? ice::equilibrationPressure<2>(2, fluid_eos, fluid_mass, fluid_temperature, p(c, 0))
+                              : ice::equilibrationPressure(fluids, fluid_eos, fluid_mass, fluid_temperature, p(c, 0));
+              r.status = f.status;
+              r.pressure = f.pressure;
+              for (int m = 0; m < nm; ++m) mass_density[m] = 0.0, r.volume_fraction[m] = 0.0;
+              for (int a = 0; a < fluids; ++a) {
+                const int m = fluid[a];
+                mass_density[m] = fluid_mass[a];
+                r.volume_fraction[m] = f.volume_fraction[a];
+                r.density[m] = f.density[a];
+                r.compressibility[m] = f.compressibility[a];
+              }
+              for (int m = 0; m < nm; ++m) {
+                if (!roles.lagrangian[m]) continue;
+                const double rho_s = eos[m].density(f.pressure, temperature[m]);
+                r.density[m] = rho_s;
+                r.compressibility[m] = 1.0 / (rho_s * eos[m].sound_speed_squared(rho_s, temperature[m]));
+                particle_volume(c, m) = 1.0 / eos[m].solid.reference_density;
+              }
+            } else {
+              // A trace of a material (less than kNegligibleMassShare of the cell's mass: e.g. air
+              // advected to a denormal density into a cell that sand and water fill) cannot fill the
+              // room that the others leave; it takes no part in the root (it would drive p to 0).
+              double cell_mass = 0;
+              for (int m = 0; m < nm; ++m) cell_mass += mass_density[m];
+              for (int m = 0; m < nm; ++m)
+                if (!(mass_density[m] > kNegligibleMassShare * cell_mass)) mass_density[m] = 0.0;
+              ice::MaterialArray<ice::Eos> local = eos;
+              for (int m = 0; m < nm; ++m) {
+                if (!roles.lagrangian[m]) continue;
+                const bool present = mass_density[m] > 0 && theta(c, m) > 0;
+                if (present) local[m] = ice::SolidEos(bulk[m], mass_density[m] / theta(c, m), p_ref(c, 0) + shift);
+                // The particles' own specific volume, before the equilibration compresses the solid's
+                // share (faceVelocities); where the solid is absent or a trace, its material's.
+                particle_volume(c, m) = present ? theta(c, m) / mass_density[m] : 1.0 / eos[m].solid.reference_density;
+              }
+              r = ice::equilibrationPressure<N>(nm, local, mass_density, temperature, p(c, 0));
             }
-            r = ice::equilibrationPressure<N>(nm, local, mass_density, temperature, p(c, 0));
           } else {
             r = ice::equilibrationPressure<N>(nm, eos, mass_density, temperature, p(c, 0));
           }
@@ -589,6 +658,28 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
   const bool with_solids = roles_.any_solid;
   const auto particle_volume = solid_particle_volume_.view();
   const auto closed = closed_;
+  // On a face between two cells that no solid reaches (markSolidCells) the fluids take a short
+  // path: their exchange among themselves alone (the solids have no weight in it there), and the
+  // solids' columns, which the pressure phase does not read on such a face, set as the general path
+  // sets those of a material absent on both sides. Bit for bit the general path's values: the
+  // elimination visits the materials with mass in the same order either way (ice/exchange.hpp). Not
+  // where the fluids' exchange among themselves is off but not with the solids (the general path
+  // would then still solve), nor with fewer than two fluids.
+  ice::MaterialArray<int> fluid{};
+  int fluids = 0;
+  bool fluids_coupled = false, any_coupled = false;
+  for (int m = 0; m < n; ++m) {
+    if (!roles.lagrangian[m] && !roles.rigid[m]) fluid[fluids++] = m;
+    for (int o = 0; o < n; ++o) any_coupled = any_coupled || (o != m && K(m, o) != 0.0);
+  }
+  ice::ExchangeCoefficients K_fluids = ice::ExchangeCoefficients::uniform(0.0);
+  for (int a = 0; a < fluids; ++a)
+    for (int b = 0; b < fluids; ++b) {
+      K_fluids.value[a][b] = K(fluid[a], fluid[b]);
+      fluids_coupled = fluids_coupled || (a != b && K(fluid[a], fluid[b]) != 0.0);
+    }
+  const bool short_path = with_solids && fluids >= 2 && fluids_coupled == any_coupled && solid_cells_.extent(0) > 0;
+  const auto solid_cells = solid_cells_;
   forMaterialCount(n, [&](auto count) {
     constexpr int N = decltype(count)::value;
     for (int d = 0; d < Dim; ++d) {
@@ -626,6 +717,36 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
               return;
             }
             const double pressure_difference = p(c, 0) - p(l, 0);
+            if (short_path && !solid_cells(c) && !solid_cells(l)) {
+              ice::MaterialArray<double> tl{}, tr{}, vl{}, vr{}, vel{}, sv{};
+              for (int a = 0; a < fluids; ++a) {
+                const int m = fluid[a];
+                tl[a] = theta(l, m), tr[a] = theta(c, m), vl[a] = v(l, m), vr[a] = v(c, m);
+                const double rl = rho(l, m), rr = rho(c, m);
+                const double mean = (rl * u(l, m * Dim + d) + rr * u(c, m * Dim + d)) / (rl + rr + kTiny);
+                vel[a] = mean - dt_per_h * ice::harmonicMean(vl[a], vr[a]) * pressure_difference + dt * g;
+              }
+              if (fluids == 2) ice::exchangeMomentumFC<2>(2, dt, K_fluids, tl, tr, vl, vr, vel, sv);
+              else ice::exchangeMomentumFC(fluids, dt, K_fluids, tl, tr, vl, vr, vel, sv);
+              const FaceMixture mix = faceMixture(fluids, tl, tr, tl, tr, vel, sv, [](int) { return false; });
+              const double mixture = mix.velocity, mixture_sv = mix.specific_volume;
+              for (int a = 0; a < fluids; ++a) {
+                const int m = fluid[a];
+                const bool present = tl[a] + tr[a] > 2 * kNegligibleVolumeShare;
+                uf(c, m) = present ? vel[a] : mixture;
+                vf(c, m) = present ? sv[a] : mixture_sv;
+              }
+              for (int m = 0; m < nm; ++m) {
+                if (roles.rigid[m]) {
+                  uf(c, m) = vf(c, m) = kinematic(c, m) = 0.0;
+                } else if (roles.lagrangian[m]) {
+                  uf(c, m) = kinematic(c, m) = mixture;
+                  vf(c, m) = mixture_sv;
+                }
+              }
+              beta(c, 0) = mix.beta;
+              return;
+            }
             ice::MaterialArray<double> tl{}, tr{}, vl{}, vr{}, vel{}, sv{}, own{};
             for (int m = 0; m < nm; ++m) {
               tl[m] = theta(l, m), tr[m] = theta(c, m), vl[m] = v(l, m), vr[m] = v(c, m);
@@ -669,23 +790,14 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
             // air next to the bed's cut cells left at up to ~100 m/s when the equilibration
             // pressure jumped by MPa: the correction that cancels such a jump then differed
             // between the water and the trace, and the trace's outflux refused the step.)
-            double b = 0, weight = 0, momentum = 0, specific_volume = 0;
-            for (int m = 0; m < nm; ++m) {
-              if (roles.rigid[m]) continue;
-              const double w = (tl[m] + tr[m]) / sv[m];
-              weight += w;
-              momentum += w * vel[m];
-              specific_volume += w * sv[m];
-              b += 0.5 * (fl[m] + fr[m]) * sv[m];
-            }
+            const FaceMixture mix = faceMixture(nm, tl, tr, fl, fr, vel, sv, [&](int m) { return roles.rigid[m] != 0; });
             // A rigid body closes its larger share of the face; the other materials flow through
             // the rest (a face inside it, or on its surface, is a wall). A moving body's share is
             // the time its box covers the face in the step (MpmSolver::particlesToCells), so the
             // fluids cross what it opens (behind it) or what it has not closed yet (ahead of it) at
             // its speed. It keeps its own face velocity and takes no pressure correction.
             const double open = with_solids ? 1.0 - rigidClosedShare(nm, roles, share, c) : 1.0;
-            const double mixture = momentum / (weight + kTiny);
-            const double mixture_sv = weight > 0 ? specific_volume / weight : b;
+            const double mixture = mix.velocity, mixture_sv = mix.specific_volume;
             for (int m = 0; m < nm; ++m) {
               if (roles.rigid[m]) {
                 // Its own motion is all of it (solidVolumeChange holds it): the pressure equation's
@@ -701,7 +813,7 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
               uf(c, m) = open * (present ? vel[m] : mixture);
               vf(c, m) = open * (present ? sv[m] : mixture_sv);  // and follows the mixture's pressure correction
             }
-            beta(c, 0) = open * b;
+            beta(c, 0) = open * mix.beta;
           });
     }
   });
@@ -711,18 +823,20 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
   if (with_solids) solid_kinematic_velocity_.exchangeHalo();
 }
 
-// [5] The cells (owned and ghost) where a solid is or reaches: a solid's mass, volume fraction, or
+// [3] The cells (owned and ghost) where a solid is or reaches: a solid's mass, volume fraction, or
 // share or cover of one of the cell's lower faces (the faces stored at the cell) is not zero. On a
-// face between two cells outside the mask no solid lies on either side, and the pressure phase's
-// face kernels take the fluids' short path there, with the values their general path gives when
-// every solid term is zero: the solids cover a few per cent of the seed scene's open cells, and the
-// general path reads all of their columns on every face, which the kernels' memory traffic
-// follows. A solid's face velocity is then left at zero there (no share of the face carries it).
-// The owned cells none of whose faces a solid reaches (quietCell) are marked too, for the kernels
-// that visit a cell's faces together. Marked once per pressure phase: nothing in it moves a solid.
-// (The fluids' fractions on such faces stay the slab profile's: taken from the upwind cell, as
-// without solids, they switched with a solid's trace in a neighbouring cell, which round-off makes
-// on one decomposition and not on another; doc/mpmice.md, "Cost".)
+// face between two cells outside the mask no solid lies on either side, and the face velocities and
+// the pressure phase's face kernels take the fluids' short path there, with the values their
+// general path gives when every solid term is zero: the solids cover a few per cent of the seed
+// scene's open cells, and the general path reads all of their columns on every face, which the
+// kernels' memory traffic follows. A solid's face velocity there is the fluids' mixture's (as for
+// any material absent on both sides), and no correction moves it (no share of the face carries it).
+// The owned cells that are not marked and have no marked neighbour (quietCell) are marked too, for
+// the kernels that visit a cell and its faces together. Marked once per step, at the equilibration
+// (or by the coupled step as it sets the solids' columns, solidCellsToMark): no phase from there to
+// the exchange moves a solid. (The fluids' fractions on such faces stay the slab profile's: taken
+// from the upwind cell, as without solids, they switched with a solid's trace in a neighbouring
+// cell, which round-off makes on one decomposition and not on another; doc/mpmice.md, "Cost".)
 template <int Dim>
 void IceSolver<Dim>::markSolidCells(const CellState<Dim>& state)
 {
@@ -751,6 +865,13 @@ void IceSolver<Dim>::markSolidCells(const CellState<Dim>& state)
         }
         marked(c) = solid ? 1 : 0;
       });
+  markQuietCells();
+}
+
+template <int Dim>
+void IceSolver<Dim>::markQuietCells()
+{
+  const auto marked = solid_cells_;
   if (quiet_cells_.extent(0) != std::size_t(layout_->ownedCells()))
     quiet_cells_ = CellMask("quiet cells", layout_->ownedCells());
   auto quiet = quiet_cells_;
@@ -759,9 +880,9 @@ void IceSolver<Dim>::markSolidCells(const CellState<Dim>& state)
       "ice::markQuietCells", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
       KOKKOS_LAMBDA(const LocalOrdinal c) {
         bool none = !marked(c);
-        for (int d = 0; d < Dim; ++d) {
-          const LocalOrdinal r = neighbours(c, 2 * d + 1);
-          none = none && !(r >= 0 && marked(r));
+        for (int f = 0; f < 2 * Dim; ++f) {
+          const LocalOrdinal o = neighbours(c, f);
+          none = none && !(o >= 0 && marked(o));
         }
         quiet(c) = none ? 1 : 0;
       });
@@ -1269,6 +1390,7 @@ void IceSolver<Dim>::momentumSourcePhase(CellState<Dim>& state, double dt)
   // New velocities go to a second field so that the viscous stencil reads old values only.
   auto un = new_velocity_.view();
   const auto is_closed = closed_;
+  const auto quiet_cells = quiet_cells_;
   forMaterialCount(n, [&](auto count) {
     constexpr int N = decltype(count)::value;
     Kokkos::parallel_for(
@@ -1322,10 +1444,13 @@ void IceSolver<Dim>::momentumSourcePhase(CellState<Dim>& state, double dt)
             // opens holds a trace of fluid stretched to near vacuum, which is not pore fluid (counted
             // by its volume, its ~-1e5 Pa stopped a sand column collapsing in air after 17 mm
             // against the dry column's 90; test VoidInADilatingSandDoesNotPullOnIt, doc/mpmice.md).
+            // Where no solid is in the cell or beside it (quietCell) the solids' columns are left
+            // unread: their volume fractions and shares of the faces are zero there.
+            const bool quiet = quietCell(quiet_cells, c);
             const auto p_ref = [&](LocalOrdinal cell, int) { return p_ref_static(cell, 0) + shift; };
             const auto acting = [&](LocalOrdinal cell) {
               double solid = 0;
-              for (int m = 0; m < nm; ++m)
+              for (int m = 0; m < nm && !quiet; ++m)
                 if (roles.reference_inside[m]) solid += theta(cell, m);
               // No such solid: the share below is 1, the cell's own pressure (in the same form).
               if (!(solid > 0)) return p_ref(cell, 0) + (p(cell, 0) - p_ref(cell, 0));
@@ -1348,7 +1473,9 @@ void IceSolver<Dim>::momentumSourcePhase(CellState<Dim>& state, double dt)
                 // The share of the face a rigid body closes is a wall (faceVelocities lets no
                 // fluid through it): the pressure of a cell the body fills, set by its trace of
                 // fluid and the body's stiffness, does not reach the fluid beside it.
-                const double closed = o < 0 || is_closed(o) ? 1.0 : rigidClosedShare(nm, roles, share[d], side == 0 ? c : o);
+                const double closed = o < 0 || is_closed(o) ? 1.0
+                                      : quiet             ? 0.0
+                                                          : rigidClosedShare(nm, roles, share[d], side == 0 ? c : o);
                 if (closed >= 1.0) {
                   face_p[side] = wall;
                   extrapolate[side] = !(rho_c > 0);
@@ -1635,7 +1762,13 @@ void IceSolver<Dim>::equilibrationPhase(CellState<Dim>& state, IceStepReport& re
 {
   Teuchos::TimeMonitor phase(*timers_.at("equilibration"));
   markClosedCells(state);
-  if (roles_.any_solid) updateReferenceShift(state);
+  if (roles_.any_solid) {
+    // For this step's phases (none of them moves a solid).
+    if (solid_cells_given_) markQuietCells();
+    else markSolidCells(state);
+    solid_cells_given_ = false;
+    updateReferenceShift(state);
+  }
   report.reference_shift = reference_shift_;
   Kokkos::deep_copy(delta_p_.view(), state.pressure.view());  // the previous step's pressure (δp is reset before use)
   report.equilibration_failures = equilibrate(state);
@@ -1695,6 +1828,7 @@ void IceSolver<Dim>::faceVelocityPhase(CellState<Dim>& state, double dt)
   Teuchos::TimeMonitor phase(*timers_.at("face velocities"));
   state.velocity.exchangeHalo();
   state.density.exchangeHalo();
+  if (roles_.any_solid && solid_cells_.extent(0) == 0) markSolidCells(state);  // (equilibrationPhase marks them)
   faceVelocities(state, dt);
 }
 
@@ -1706,7 +1840,7 @@ void IceSolver<Dim>::pressurePhase(CellState<Dim>& state, double dt, IceStepRepo
   sum_delta_p_.fill(0.0);
   const bool implicit = settings_.pressure == "implicit";
   if (roles_.any_solid) {
-    markSolidCells(state);
+    if (solid_cells_.extent(0) == 0) markSolidCells(state);  // (equilibrationPhase marks them)
     fluidFaceFractions(state, dt);
     carriedFaceBeta(1);
   }

@@ -207,6 +207,18 @@ class IceSolver {
   /// A solid's volume moves as its particles move, which near a contact or along a staircase
   /// surface is not the cell-averaged velocity times a face share.
   Field<Dim>& solidVolumeChange() { return solid_volume_change_; }
+  /// The cells (owned and ghost) where a solid is or reaches, for the next equilibrationPhase and
+  /// the phases after it in the step: a caller that sets the solids' columns (the coupled step, from
+  /// the particles) marks them here as it sets them, with markSolidCells' rule (a solid's mass,
+  /// volume fraction, share or cover of one of the cell's lower faces not zero), which spares the
+  /// equilibration a pass over every solid column; otherwise the equilibration marks them itself.
+  CellMask& solidCellsToMark()
+  {
+    if (solid_cells_.extent(0) != std::size_t(layout_->overlapCells()))
+      solid_cells_ = CellMask("solid cells", layout_->overlapCells());
+    solid_cells_given_ = true;
+    return solid_cells_;
+  }
   /// Kinematic solids (the staggered coupling, mpm.coupling: staggered): the deformable solids'
   /// motion over the step is fixed before the pressure (solidVolumeChange holds all of it), so on
   /// faces and in the pressure equation they are treated as a moving rigid body is: each closes
@@ -266,6 +278,7 @@ class IceSolver {
   void updatePressureRows();
   void fluidFaceFractions(const CellState<Dim>& state, double dt);
   void markSolidCells(const CellState<Dim>& state);
+  void markQuietCells();
   void energy(CellState<Dim>& state, const Field<Dim>& old_specific_volume, double dt);
 
   Scene scene_;
@@ -278,7 +291,8 @@ class IceSolver {
   CellMask closed_;         // closedCells()
   CellMask without_row_;    // cellsWithoutPressureRow()
   CellMask solid_cells_;    // markSolidCells(): a solid is or reaches here (owned and ghost cells)
-  CellMask quiet_cells_;    // markSolidCells(): no solid reaches any face of the owned cell
+  CellMask quiet_cells_;    // markQuietCells(): no solid reaches the owned cell or any of its faces
+  bool solid_cells_given_ = false;  // solidCellsToMark() since the last equilibrationPhase
   long long closed_count_ = 0;
   std::function<void(CellState<Dim>&, double)> solid_volume_predictor_;  // setSolidVolumePredictor
   /// The roles of the face phases (face velocities and exchange, the pressure equation): roles_,

@@ -287,10 +287,13 @@ void MpmIceStep<Dim>::cellsFromParticles(CellState<Dim>& state, double dt)
     face_share[d] = ice_->solidFaceShares().direction(d).view();
     face_cover[d] = ice_->solidFaceCovers().direction(d).view();
   }
+  // The cells where a solid is or reaches, marked as their columns are set (IceSolver::solidCellsToMark).
+  auto marked = ice_->solidCellsToMark();
   // The sums are complete on the ghosts as well, so every local cell is set without a halo exchange.
   Kokkos::parallel_for(
       "mpmice::cellsFromParticles", Kokkos::RangePolicy<ExecutionSpace>(0, state.density.overlapCount()),
       KOKKOS_LAMBDA(const LocalOrdinal c) {
+        bool solid = false;  // (a NaN is not zero: the phases' general path reports it)
         // The particles' domains of two solids can overlap in a cell where their particles do not
         // (each fills its own GIMP box): the solids then share the cell in proportion.
         double solid_volume = 0;
@@ -300,19 +303,24 @@ void MpmIceStep<Dim>::cellsFromParticles(CellState<Dim>& state, double dt)
           const int m = scene_index[a];
           for (int d = 0; d < Dim; ++d)
             for (int side = 0; side < 2; ++side) {
-              face_share[d](c, 2 * m + side) = sums(c, mpm::MpmSolver<Dim>::faceColumn(nm, a, d, side));
-              face_cover[d](c, 2 * m + side) = sums(c, mpm::MpmSolver<Dim>::roomColumn(nm, a, d, side));
+              const double share = sums(c, mpm::MpmSolver<Dim>::faceColumn(nm, a, d, side));
+              const double cover = sums(c, mpm::MpmSolver<Dim>::roomColumn(nm, a, d, side));
+              face_share[d](c, 2 * m + side) = share;
+              face_cover[d](c, 2 * m + side) = cover;
+              solid = solid || share != 0.0 || cover != 0.0;
             }
           change(c, m) = (sums(c, mpm::MpmSolver<Dim>::predictedVolumeColumn(nm, a)) - sums(c, nm + a)) / volume;
           const double mass = sums(c, a);
           rho(c, m) = mass / volume;
           theta(c, m) = scale * sums(c, nm + a) / volume;
+          solid = solid || rho(c, m) != 0.0 || theta(c, m) != 0.0;
           for (int d = 0; d < Dim; ++d) {
             const double velocity = mass > 0 ? sums(c, 2 * nm + a * Dim + d) / mass : 0.0;
             u(c, m * Dim + d) = velocity;
             solid_u(c, a * Dim + d) = velocity;
           }
         }
+        marked(c) = solid ? 1 : 0;
       });
 }
 

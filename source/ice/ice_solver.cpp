@@ -669,7 +669,7 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
   int fluids = 0;
   bool fluids_coupled = false, any_coupled = false;
   for (int m = 0; m < n; ++m) {
-    if (!roles.lagrangian[m] && !roles.rigid[m]) fluid[fluids++] = m;
+    if (!roles.solid(m)) fluid[fluids++] = m;
     for (int o = 0; o < n; ++o) any_coupled = any_coupled || (o != m && K(m, o) != 0.0);
   }
   ice::ExchangeCoefficients K_fluids = ice::ExchangeCoefficients::uniform(0.0);
@@ -857,7 +857,7 @@ void IceSolver<Dim>::markSolidCells(const CellState<Dim>& state)
       KOKKOS_LAMBDA(const LocalOrdinal c) {
         bool solid = false;  // a NaN is not zero: it takes the general path, which reports it
         for (int m = 0; m < n && !solid; ++m) {
-          if (!roles.lagrangian[m] && !roles.rigid[m]) continue;
+          if (!roles.solid(m)) continue;
           solid = theta(c, m) != 0.0 || rho(c, m) != 0.0;
           for (int d = 0; d < Dim && !solid; ++d)
             for (int side = 0; side < 2; ++side)
@@ -935,7 +935,7 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
           // these hold more than the face.
           const bool solids_here = solid_cells(c) || (l >= 0 && solid_cells(l));
           for (int m = 0; m < n; ++m) {
-            if (roles.lagrangian[m] || roles.rigid[m]) {
+            if (roles.solid(m)) {
               for (int side = 0; side < 2 && solids_here; ++side) {
                 (roles.rigid[m] ? rigid : deformable)[side] += math::min(1.0, share(c, 2 * m + side));
                 swept[side] += math::min(1.0, cover(c, 2 * m + side));
@@ -998,7 +998,7 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
           if (swept[0] < rigid[0] + covered || swept[1] < rigid[1] + covered) {  // else the layers hold anyway
             double mass = 0, momentum[3] = {0, 0, 0};
             for (int m = 0; m < n; ++m) {
-              if (!roles.lagrangian[m] || roles.rigid[m]) continue;
+              if (!roles.deformable(m)) continue;
               for (int k = 0; k < 2; ++k) {
                 const LocalOrdinal cell = k == 0 ? c : l;
                 if (cell < 0) continue;
@@ -1020,7 +1020,7 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
             double donor_solid = 0;
             if (donor >= 0 && solids_here)
               for (int m = 0; m < n; ++m)
-                if (roles.lagrangian[m] || roles.rigid[m]) donor_solid += theta(donor, m);
+                if (roles.solid(m)) donor_solid += theta(donor, m);
             const bool fill = donor_solid > kSolidPresent && fluid[side] > kFillMinimum;
             keep[side] = fluid[side] > 0 && (fill || fluid[side] > room) ? room / fluid[side] : 1.0;
             // Filling the room, a donor's fluids, which the face exchange ties to the solid there,
@@ -1040,7 +1040,7 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
             }
           }
           for (int m = 0; m < n; ++m)
-            if (!roles.lagrangian[m] && !roles.rigid[m])
+            if (!roles.solid(m))
               for (int side = 0; side < 2; ++side) out(c, 2 * m + side) = profile[side][m] * keep[side];
           if (l >= 0) leaves(l, 2 * d + 1) = keep[0];
           leaves(c, 2 * d) = keep[1];
@@ -1596,7 +1596,7 @@ void IceSolver<Dim>::filterOddEven(const CellState<Dim>& state)
           for (int col = 0; col < columns; ++col) {
             const int m = col / Dim;
             const double rc = rho(c, m);
-            const bool filtered = !roles.lagrangian[m] && !roles.rigid[m] && rc > 0 && !closed(c);
+            const bool filtered = !roles.solid(m) && rc > 0 && !closed(c);
             laplacian(c, col) = filtered ? weightedDifference(c, col, rc, un) / rc : 0.0;
           }
         });
@@ -1612,7 +1612,7 @@ void IceSolver<Dim>::filterOddEven(const CellState<Dim>& state)
           for (int col = 0; col < columns; ++col) {
             const int m = col / Dim;
             const double rc = rho(c, m);
-            if (roles.lagrangian[m] || roles.rigid[m] || !(rc > 0) || closed(c)) continue;
+            if (roles.solid(m) || !(rc > 0) || closed(c)) continue;
             increment(c, col) -= kappa * weightedDifference(c, col, rc, laplacian) / rc;
           }
         });

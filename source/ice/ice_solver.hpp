@@ -84,6 +84,11 @@ struct MaterialRoles {
   ice::MaterialArray<int> rigid{};
   ice::MaterialArray<int> reference_inside{};  // a solid that feels the reference pressure where it fills a cell
   bool any_solid = false;
+
+  /// A solid, rigid or not (the particles' material); else a fluid.
+  KOKKOS_INLINE_FUNCTION bool solid(int m) const { return lagrangian[m] || rigid[m]; }
+  /// A solid that is not rigid: it deforms and answers the pressure.
+  KOKKOS_INLINE_FUNCTION bool deformable(int m) const { return lagrangian[m] && !rigid[m]; }
 };
 
 /// The time-step limit and what set it.
@@ -313,7 +318,7 @@ class IceSolver {
     MaterialRoles roles = roles_;
     if (kinematic_solids_)
       for (int m = 0; m < ice::kMaxMaterials; ++m)
-        if (roles.lagrangian[m] && !roles.rigid[m]) roles.reference_inside[m] = 1;
+        if (roles.deformable(m)) roles.reference_inside[m] = 1;
     return roles;
   }
   ice::MaterialArray<ice::Eos> eos_;

@@ -526,18 +526,23 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
           }
           ice::EquilibrationResult r;
           if constexpr (kSolids) {
+            // A trace of a material (less than kNegligibleMassShare of the cell's mass: e.g. air
+            // advected to a denormal density into a cell that sand and water fill) cannot fill the
+            // room that the others leave; it takes no part in the root (it would drive p to 0).
+            double cell_mass = 0;
+            for (int m = 0; m < nm; ++m) cell_mass += mass_density[m];
+            for (int m = 0; m < nm; ++m)
+              if (!(mass_density[m] > kNegligibleMassShare * cell_mass)) mass_density[m] = 0.0;
             if (fluids_alone && !solid_cells(c)) {
               // No solid here (markSolidCells): the fluids' root alone, which is the general one to
               // the bit (materials without mass take no part in it, ice/equilibration.hpp), and the
               // solids' columns as the general path sets those of an absent solid.
               ice::MaterialArray<ice::Eos> fluid_eos;
               ice::MaterialArray<double> fluid_mass{}, fluid_temperature{};
-              double cell_mass = 0;
-              for (int a = 0; a < fluids; ++a) cell_mass += mass_density[fluid[a]];
               for (int a = 0; a < fluids; ++a) {
                 const int m = fluid[a];
                 fluid_eos[a] = eos[m];
-                fluid_mass[a] = mass_density[m] > kNegligibleMassShare * cell_mass ? mass_density[m] : 0.0;
+                fluid_mass[a] = mass_density[m];
                 fluid_temperature[a] = temperature[m];
               }
               const ice::EquilibrationResult f =
@@ -545,10 +550,9 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
                               : ice::equilibrationPressure(fluids, fluid_eos, fluid_mass, fluid_temperature, p(c, 0));
               r.status = f.status;
               r.pressure = f.pressure;
-              for (int m = 0; m < nm; ++m) mass_density[m] = 0.0, r.volume_fraction[m] = 0.0;
+              for (int m = 0; m < nm; ++m) r.volume_fraction[m] = 0.0;
               for (int a = 0; a < fluids; ++a) {
                 const int m = fluid[a];
-                mass_density[m] = fluid_mass[a];
                 r.volume_fraction[m] = f.volume_fraction[a];
                 r.density[m] = f.density[a];
                 r.compressibility[m] = f.compressibility[a];
@@ -561,13 +565,6 @@ int IceSolver<Dim>::equilibrate(CellState<Dim>& state)
                 particle_volume(c, m) = 1.0 / eos[m].solid.reference_density;
               }
             } else {
-              // A trace of a material (less than kNegligibleMassShare of the cell's mass: e.g. air
-              // advected to a denormal density into a cell that sand and water fill) cannot fill the
-              // room that the others leave; it takes no part in the root (it would drive p to 0).
-              double cell_mass = 0;
-              for (int m = 0; m < nm; ++m) cell_mass += mass_density[m];
-              for (int m = 0; m < nm; ++m)
-                if (!(mass_density[m] > kNegligibleMassShare * cell_mass)) mass_density[m] = 0.0;
               ice::MaterialArray<ice::Eos> local = eos;
               for (int m = 0; m < nm; ++m) {
                 if (!roles.lagrangian[m]) continue;

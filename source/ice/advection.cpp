@@ -328,18 +328,18 @@ QuantityColumns<Dim, View, kMaxFields> quantityColumns(const std::vector<FieldPo
 
 template <int Dim>
 const typename Advector<Dim>::WorkView& Advector<Dim>::slabDensities(const FaceField<Dim>& face_velocity, double dt,
-                                                                     const Field<Dim>& mass)
+                                                                     const Field<Dim>& mass, const CellMask& skip)
 {
   if (slab_density_.extent(0) == 0)
     slab_density_ = WorkView("advection slab density", layout_->overlapCells(), 2 * Dim, materials_);
-  reconstruct(face_velocity, dt, mass, {}, true);
+  reconstruct(face_velocity, dt, mass, {}, true, CapView(), skip);
   return slab_density_;
 }
 
 template <int Dim>
 LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass,
                                           const std::vector<Field<Dim>*>& mass_specific, bool slab_densities,
-                                          const CapView& outflow_share)
+                                          const CapView& outflow_share, const CellMask& skip)
 {
   const bool capped = outflow_share.extent(0) > 0;
   const Slabs<Dim> slabs(face_velocity, *layout_, dt, options_.transverse_correction);
@@ -362,6 +362,7 @@ LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, d
   const LocalOrdinal owned = layout_->ownedCells();
   const auto closed = options_.closed_cells;
   const bool any_closed = closed.extent(0) > 0;
+  const bool skipping = skip.extent(0) > 0;
 
   // Per cell (owned and ghost, so that every owned face has its donor) and material, the slab
   // geometry from the cell's 2 Dim face velocities, then:
@@ -378,6 +379,7 @@ LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, d
   Kokkos::parallel_reduce(
       "advection slabs", Kokkos::RangePolicy<ExecutionSpace>(0, cells),
       KOKKOS_LAMBDA(int c, LargestOutflow& best) {
+        if (skipping && skip(c)) return;  // (slabDensities: not read)
         if (any_closed && closed(c)) {
           // Nothing leaves; update() skips the cell. Its slabs are zero (its faces' velocities are).
           for (int m = 0; m < materials; ++m)

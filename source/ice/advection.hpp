@@ -100,8 +100,12 @@ class Advector {
   /// material. Where nothing leaves through a face, the profile's value at the face. The pressure
   /// equation takes its volume fluxes from it when solids share the cells, so that the volume it
   /// makes room for is the volume the advection brings. Needs current ghosts of both inputs.
+  /// skip (optional, owned and ghost cells): cells whose slabs the caller does not read; their
+  /// entries are left as they were.
   using WorkView = Kokkos::View<double***, MemorySpace>;  // (local cell, face, material)
-  const WorkView& slabDensities(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass);
+  using CellMask = Kokkos::View<unsigned char*, MemorySpace>;
+  const WorkView& slabDensities(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass,
+                                const CellMask& skip = CellMask());
 
   int materials() const { return materials_; }
 
@@ -113,7 +117,7 @@ class Advector {
   /// The slab pass; returns this rank's largest outflow fraction and where it occurs.
   LargestOutflow reconstruct(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass,
                              const std::vector<Field<Dim>*>& mass_specific, bool slab_densities = false,
-                             const CapView& outflow_share = CapView());
+                             const CapView& outflow_share = CapView(), const CellMask& skip = CellMask());
   AdvectionStatus outfluxStatus(const LargestOutflow& local) const;
   void update(Field<Dim>& mass, const std::vector<Field<Dim>*>& mass_specific);
 

@@ -831,9 +831,10 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
 // The owned cells that are not marked and have no marked neighbour (quietCell) are marked too, for
 // the kernels that visit a cell and its faces together. Marked once per step, at the equilibration
 // (or by the coupled step as it sets the solids' columns, solidCellsToMark): no phase from there to
-// the exchange moves a solid. (The fluids' fractions on such faces stay the slab profile's: taken
-// from the upwind cell, as without solids, they switched with a solid's trace in a neighbouring
-// cell, which round-off makes on one decomposition and not on another; doc/mpmice.md, "Cost".)
+// the exchange moves a solid. (The fluids' fractions on a face between unmarked cells are the
+// upwind cell's, as without solids, and blend into the slab profile's as a solid appears on the
+// face or in a donor: switched on the marks, they changed with a solid's trace in a neighbouring
+// cell, which round-off makes on one decomposition and not on another; fluidFaceFractions.)
 template <int Dim>
 void IceSolver<Dim>::markSolidCells(const CellState<Dim>& state)
 {
@@ -869,12 +870,14 @@ template <int Dim>
 void IceSolver<Dim>::markQuietCells()
 {
   const auto marked = solid_cells_;
-  if (quiet_cells_.extent(0) != std::size_t(layout_->ownedCells()))
-    quiet_cells_ = CellMask("quiet cells", layout_->ownedCells());
+  // Owned and ghost cells: a ghost's neighbours beyond the halo count as unmarked, but no face
+  // between a ghost and such a cell is read (fluidFaceFractions' slabs).
+  if (quiet_cells_.extent(0) != std::size_t(layout_->overlapCells()))
+    quiet_cells_ = CellMask("quiet cells", layout_->overlapCells());
   auto quiet = quiet_cells_;
   const auto neighbours = layout_->cellNeighbours();
   Kokkos::parallel_for(
-      "ice::markQuietCells", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
+      "ice::markQuietCells", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->overlapCells()),
       KOKKOS_LAMBDA(const LocalOrdinal c) {
         bool none = !marked(c);
         for (int f = 0; f < 2 * Dim; ++f) {
@@ -891,11 +894,15 @@ void IceSolver<Dim>::markQuietCells()
 // differ from what the advection moves wherever the fraction varies steeply (the water between a
 // sand front and a face, the water of a cut cell), and next to a solid or the bed the mismatch has
 // nowhere soft to go: 1e-5 of a cell in water and sand is a pressure error of ~100 kPa, where in
-// water and air it is a few Pa. Fluids alone keep the upwind cell's fraction.
+// water and air it is a few Pa. Fluids alone keep the upwind cell's fraction, and so do the faces
+// where no solid is (it spares the slabs and the room of the faces that no solid reaches: the
+// fractions and their two slab passes were ~3.5 s of the 10 mm seed scene's 22 s per 211 steps;
+// doc/mpmice.md, "Cost").
 template <int Dim>
 void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
 {
-  const auto& slab = advector_->slabDensities(face_velocity_, dt, state.density);
+  // The slabs of the cells that neither hold nor border a solid are not read (below).
+  const auto& slab = advector_->slabDensities(face_velocity_, dt, state.density, quiet_cells_);
   const auto v = state.specific_volume.view();
   const auto theta = state.volume_fraction.view();
   const auto rho = state.density.view();
@@ -925,24 +932,49 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
           // A solid's columns of `out` stay as constructed, zero: nothing reads them (a solid's
           // flux takes its share of the face), and leaving them unwritten spares the kernel, which
           // memory bounds, a quarter of its streams.
-          double fluid[2] = {0, 0}, rigid[2] = {0, 0}, deformable[2] = {0, 0}, swept[2] = {0, 0};
-          double profile[2][ice::kMaxMaterials];  // each fluid's profile on the face, per donor side
-          // Without a solid on either side (markSolidCells) their shares, covers and volumes are
-          // zero: left unread, the face is all room, and the fluids keep their profiles unless
-          // these hold more than the face.
-          const bool solids_here = solid_cells(c) || (l >= 0 && solid_cells(l));
-          for (int m = 0; m < n; ++m) {
-            if (roles.solid(m)) {
-              for (int side = 0; side < 2 && solids_here; ++side) {
-                (roles.rigid[m] ? rigid : deformable)[side] += math::min(1.0, share(c, 2 * m + side));
-                swept[side] += math::min(1.0, cover(c, 2 * m + side));
-              }
-              continue;
+          if (!(solid_cells(c) || (l >= 0 && solid_cells(l)))) {
+            // No solid on either side (markSolidCells): the upwind cells' fractions, as without
+            // solids, and all of each slab leaves in the advection.
+            for (int m = 0; m < n; ++m) {
+              if (roles.solid(m)) continue;
+              out(c, 2 * m) = l >= 0 ? theta(l, m) : theta(c, m);
+              out(c, 2 * m + 1) = theta(c, m);
             }
+            if (l >= 0) leaves(l, 2 * d + 1) = 1.0;
+            leaves(c, 2 * d) = 1.0;
+            return;
+          }
+          double fluid[2] = {0, 0}, rigid[2] = {0, 0}, deformable[2] = {0, 0}, swept[2] = {0, 0};
+          double donor_solid[2] = {0, 0};  // the solids' volume fraction of each donor
+          for (int m = 0; m < n; ++m) {
+            if (!roles.solid(m)) continue;
+            for (int side = 0; side < 2; ++side) {
+              (roles.rigid[m] ? rigid : deformable)[side] += math::min(1.0, share(c, 2 * m + side));
+              swept[side] += math::min(1.0, cover(c, 2 * m + side));
+            }
+            if (l >= 0) donor_solid[0] += theta(l, m);
+            donor_solid[1] += theta(c, m);
+          }
+          // The advection's slab profile where a solid is on the face or in a donor; the upwind
+          // cell's fraction where none is, blended in below kSolidPresent of the solids' largest
+          // share, cover or volume fraction here, so that a solid's trace at round-off (which the
+          // particles' sums leave on one decomposition and not on another) changes the fractions
+          // by as little (doc/mpmice.md, "Cost").
+          double presence = 0;
+          for (int side = 0; side < 2; ++side)
+            presence = math::max(presence, math::max(math::max(rigid[side], deformable[side]),
+                                                     math::max(swept[side], donor_solid[side])));
+          const double slab_weight = math::min(1.0, presence / kSolidPresent);
+          double profile[2][ice::kMaxMaterials];  // each fluid's profile on the face, per donor side
+          for (int m = 0; m < n; ++m) {
+            if (roles.solid(m)) continue;
             // Donor below the face (its upper face 2 d + 1) and donor above (this cell's lower face).
-            profile[0][m] = l >= 0 ? slab(l, 2 * d + 1, m) * v(l, m) : theta(c, m);
-            profile[1][m] = slab(c, 2 * d, m) * v(c, m);
-            fluid[0] += profile[0][m], fluid[1] += profile[1][m];
+            const double upwind[2] = {l >= 0 ? theta(l, m) : theta(c, m), theta(c, m)};
+            const double slabs[2] = {l >= 0 ? slab(l, 2 * d + 1, m) * v(l, m) : theta(c, m), slab(c, 2 * d, m) * v(c, m)};
+            for (int side = 0; side < 2; ++side) {
+              profile[side][m] = slab_weight >= 1.0 ? slabs[side] : upwind[side] + slab_weight * (slabs[side] - upwind[side]);
+              fluid[side] += profile[side][m];
+            }
           }
           // The fluids cross a face in the room the solids leave there. A cell's linear profile
           // cannot hold the sharp edge of a solid inside the cell: above a sand surface it would
@@ -1014,11 +1046,7 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
             const double closed = layers + across_motion * (math::min(layers, swept[side]) - layers);
             const double room = closed < 1.0 ? 1.0 - closed : 0.0;
             const LocalOrdinal donor = side == 0 ? l : c;
-            double donor_solid = 0;
-            if (donor >= 0 && solids_here)
-              for (int m = 0; m < n; ++m)
-                if (roles.solid(m)) donor_solid += theta(donor, m);
-            const bool fill = donor_solid > kSolidPresent && fluid[side] > kFillMinimum;
+            const bool fill = donor_solid[side] > kSolidPresent && fluid[side] > kFillMinimum;
             keep[side] = fluid[side] > 0 && (fill || fluid[side] > room) ? room / fluid[side] : 1.0;
             // Filling the room, a donor's fluids, which the face exchange ties to the solid there,
             // may not carry out more than the donor holds at the solid's speed across the face:

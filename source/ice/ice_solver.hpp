@@ -296,7 +296,7 @@ class IceSolver {
   CellMask closed_;         // closedCells()
   CellMask without_row_;    // cellsWithoutPressureRow()
   CellMask solid_cells_;    // markSolidCells(): a solid is or reaches here (owned and ghost cells)
-  CellMask quiet_cells_;    // markQuietCells(): no solid reaches the owned cell or any of its faces
+  CellMask quiet_cells_;    // markQuietCells(): no solid reaches the cell or any of its faces (owned and ghost cells)
   bool solid_cells_given_ = false;  // solidCellsToMark() since the last equilibrationPhase
   long long closed_count_ = 0;
   std::function<void(CellState<Dim>&, double)> solid_volume_predictor_;  // setSolidVolumePredictor

@@ -273,6 +273,12 @@ IceSettings IceSettings::fromScene(const Scene& scene)
   if (!s.linear_solver.isParameter("reuse interval")) s.linear_solver.set("reuse interval", 50);
   if (!s.linear_solver.isParameter("reuse mode")) s.linear_solver.set("reuse mode", std::string("RAP"));
   if (!s.linear_solver.isParameter("reuse slowdown limit")) s.linear_solver.set("reuse slowdown limit", 1.5);
+  // The correction solves of a step (outer iteration 2 on) apply the hierarchy as its first solve
+  // refreshed it: their matrix differs from the first one by the upwind sides of a few faces (with
+  // solids) or the slope of a volume law that fell, and the refresh of the finest level's smoother
+  // cost more than it saved (the 10 mm seed scene, 1.94 outer iterations per step: 3 % of the step,
+  // CG iterations 6.33 -> 6.29 per step; doc/mpmice.md, "Cost").
+  if (!s.linear_solver.isParameter("refresh corrections")) s.linear_solver.set("refresh corrections", false);
   return s;
 }
 

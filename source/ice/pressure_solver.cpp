@@ -56,6 +56,7 @@ struct Settings {
   int reuse_interval = 1;
   ReuseMode reuse_mode = ReuseMode::KeepRP;
   double reuse_slowdown_limit = 0;  // 0: off
+  bool refresh_corrections = true;
 };
 
 std::string keysOf(const Teuchos::ParameterList& list)
@@ -120,6 +121,7 @@ Settings readSettings(Teuchos::ParameterList& list, const Teuchos::ParameterList
   if (!(s.reuse_slowdown_limit == 0 || s.reuse_slowdown_limit >= 1))
     throw inputError(prefix + "reuse slowdown limit", showNumber(s.reuse_slowdown_limit),
                      "must be 0 (off) or >= 1");
+  s.refresh_corrections = list.get<bool>("refresh corrections");
   return s;
 }
 
@@ -278,7 +280,7 @@ struct PressureSolver<Dim>::Impl {
   /// field(row_cell(k)) = rows(k), and 0 in the excluded owned cells.
   void scatter(const MultiVector& rows, MultiVector& field) const;
   Teuchos::ParameterList mueluParameters() const;
-  Teuchos::RCP<Operator> preparePreconditioner(PressureSolveReport& report);
+  Teuchos::RCP<Operator> preparePreconditioner(PressureSolveReport& report, int kind);
   double residualNorm(const MultiVector& b, const MultiVector& x, const ResidualMeasure& measure) const;
   void runCG(const Teuchos::RCP<Operator>& preconditioner, const MultiVector& b, MultiVector& x,
              const ResidualMeasure& measure, double b_norm, double tolerance, PressureSolveReport& report) const;
@@ -498,7 +500,7 @@ Teuchos::ParameterList PressureSolver<Dim>::Impl::mueluParameters() const
 }
 
 template <int Dim>
-Teuchos::RCP<Operator> PressureSolver<Dim>::Impl::preparePreconditioner(PressureSolveReport& report)
+Teuchos::RCP<Operator> PressureSolver<Dim>::Impl::preparePreconditioner(PressureSolveReport& report, int kind)
 {
   switch (settings.preconditioner) {
     case PreconditionerType::None:
@@ -521,6 +523,11 @@ Teuchos::RCP<Operator> PressureSolver<Dim>::Impl::preparePreconditioner(Pressure
     rebuild_requested = false;
     reference_due.fill(true);
     report.preconditioner_rebuilt = true;
+  } else if (kind > 0 && !settings.refresh_corrections) {
+    // A correction solve applies the hierarchy as the step's first solve left it; its finest level
+    // sees the current matrix, which differs from the one refreshed for by the upwind sides of a
+    // few faces (the ICE outer iteration). The next solve that may refresh does.
+    return muelu;
   } else if (values_changed && settings.reuse_mode != ReuseMode::Frozen) {
     // Keep the coarse levels and recompute the finest level's smoother only (RAP), keep the
     // aggregates and the transfer operators (RP) or the tentative prolongator only (tP); recompute
@@ -628,6 +635,9 @@ Teuchos::RCP<const Teuchos::ParameterList> PressureSolver<Dim>::validParameters(
   p->set("reuse slowdown limit", 0.0,
          "0: off; else a full MueLu setup follows a solve whose reused hierarchy needed more than this factor "
          "times the CG iterations per decade of residual reduction of the last fresh hierarchy");
+  p->set("refresh corrections", true,
+         "true: every solve between full setups refreshes the hierarchy as `reuse mode` says; false: a solve "
+         "of kind > 0 (the ICE step's correction solves) applies it as the last refresh left it");
   p->sublist("muelu", false, "MueLu parameters applied on top of cfdmpm's defaults");
   return p;
 }
@@ -846,7 +856,7 @@ PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>
   Teuchos::RCP<Operator> preconditioner;
   {
     Teuchos::TimeMonitor timer(*m.setup_timer);
-    preconditioner = m.preparePreconditioner(report);
+    preconditioner = m.preparePreconditioner(report, kind);
   }
   report.setup_seconds = secondsSince(start);
   const bool reused = s.preconditioner == PreconditionerType::MueLu && !report.preconditioner_rebuilt;
@@ -868,7 +878,7 @@ PressureSolveReport PressureSolver<Dim>::solve(const Field<Dim>& rhs, Field<Dim>
     start = Clock::now();
     {
       Teuchos::TimeMonitor timer(*m.setup_timer);
-      preconditioner = m.preparePreconditioner(report);
+      preconditioner = m.preparePreconditioner(report, kind);  // rebuilt (requested above)
     }
     report.setup_seconds += secondsSince(start);
     start = Clock::now();

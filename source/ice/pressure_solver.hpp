@@ -65,8 +65,9 @@ class PressureSolver {
   ///   2 plus Belos and MueLu output), "reuse interval" (1: a full MueLu setup every solve; N: every
   ///   N solves), "reuse mode" ("RAP" | "RP" | "tP" | "frozen": what happens between full setups),
   ///   "reuse slowdown limit" (0 off; else a full setup follows a reused solve that needed this
-  ///   factor more iterations per decade than the last fresh hierarchy), and a sublist "muelu"
-  ///   passed to MueLu on top of cfdmpm's defaults.
+  ///   factor more iterations per decade than the last fresh hierarchy), "refresh corrections"
+  ///   (true; false: a solve of kind > 0 applies the hierarchy as the last refresh left it), and a
+  ///   sublist "muelu" passed to MueLu on top of cfdmpm's defaults.
   static Teuchos::RCP<const Teuchos::ParameterList> validParameters();
   /// Checks settings as the constructor does, without building anything: throws InputError for an
   /// unknown key, a wrong type or a bad value, the key named after `key_prefix`. The "muelu"

@@ -84,6 +84,7 @@ Settings readSettings(Teuchos::ParameterList& list, const Teuchos::ParameterList
                        (valid_entry->isList()              ? std::string("a section")
                         : valid_entry->isType<double>()    ? std::string("a number")
                         : valid_entry->isType<int>()       ? std::string("an integer")
+                        : valid_entry->isType<bool>()      ? std::string("true or false")
                                                            : std::string("a string")));
     if (valid_entry->isType<double>() && entry.isType<int>()) list.set(key, double(entry.getValue<int>(nullptr)));
   }

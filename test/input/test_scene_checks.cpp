@@ -143,6 +143,8 @@ TEST_F(SceneTest, LinearSolverKeysAreCheckedWithTheScene)
                  {"cfdmpm.ice.linear_solver.reuse mode", "sometimes", "RAP, RP, tP, frozen"});
   expectMentions(errorOf(replaced(kFullScene, kIce, "  ice: {linear_solver: {verbosity: loud}}\n")),
                  {"cfdmpm.ice.linear_solver.verbosity", "integer"});
+  expectMentions(errorOf(replaced(kFullScene, kIce, "  ice: {linear_solver: {refresh corrections: maybe}}\n")),
+                 {"cfdmpm.ice.linear_solver.refresh corrections", "true or false"});
 }
 
 TEST_F(SceneTest, EnergyEquationWithSolidsIsRefusedWithTheScene)

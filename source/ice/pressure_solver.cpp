@@ -80,12 +80,7 @@ Settings readSettings(Teuchos::ParameterList& list, const Teuchos::ParameterList
     if (entry.isList() != valid_entry->isList() ||
         (!entry.isList() && entry.getAny(false).type() != valid_entry->getAny(false).type() &&
          !(valid_entry->isType<double>() && entry.isType<int>())))
-      throw InputError(prefix + key + ": got a value of the wrong type; expected " +
-                       (valid_entry->isList()              ? std::string("a section")
-                        : valid_entry->isType<double>()    ? std::string("a number")
-                        : valid_entry->isType<int>()       ? std::string("an integer")
-                        : valid_entry->isType<bool>()      ? std::string("true or false")
-                                                           : std::string("a string")));
+      throw InputError(prefix + key + ": got a value of the wrong type; expected " + expectedType(*valid_entry, 0));
     if (valid_entry->isType<double>() && entry.isType<int>()) list.set(key, double(entry.getValue<int>(nullptr)));
   }
   try {

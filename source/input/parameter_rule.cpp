@@ -212,4 +212,12 @@ std::string describeType(const Teuchos::ParameterEntry& valid_entry, int dimensi
   return valid_entry.getAny(false).typeName();
 }
 
+std::string expectedType(const Teuchos::ParameterEntry& valid_entry, int dimension)
+{
+  const std::string type = describeType(valid_entry, dimension);
+  if (valid_entry.isType<bool>()) return type;
+  const bool vowel = std::string("aeiou").find(type[0]) != std::string::npos;
+  return (vowel ? "an " : "a ") + type;
+}
+
 }  // namespace cfdmpm

@@ -62,6 +62,9 @@ std::string showValue(const Teuchos::ParameterEntry& entry);
 /// What kind of value an entry of a valid list holds: "number", "integer", "list of 2 numbers",
 /// "list of [x, y] points", "section". `dimension` 0 writes "list of `dimension` numbers".
 std::string describeType(const Teuchos::ParameterEntry& valid_entry, int dimension);
+/// The same with its article, as an error message's "expected ...": "a number", "an integer",
+/// "true or false".
+std::string expectedType(const Teuchos::ParameterEntry& valid_entry, int dimension);
 
 /// A number written in its shortest exact form (0.001, 2.15e+09, 101325).
 std::string showNumber(double value);

@@ -486,10 +486,8 @@ std::string givenType(const ParameterEntry& entry)
 // "a number; must be >= 0 (Pa s)": what a key of the valid list expects.
 std::string expectation(const ParameterEntry& valid_entry, int dimension)
 {
-  std::string type = describeType(valid_entry, dimension);
-  if (type == "section") type = "section (keys indented below it)";
-  const bool vowel = std::string("aeiou").find(type[0]) != std::string::npos;
-  std::string text = (type == "true or false" ? "" : vowel ? "an " : "a ") + type;
+  std::string text = expectedType(valid_entry, dimension);
+  if (valid_entry.isList()) text += " (keys indented below it)";
   const ParameterRule* rule = ruleOf(valid_entry);
   if (rule && !rule->allowed().empty()) {
     const bool list = valid_entry.isArray() || valid_entry.isTwoDArray();

@@ -1004,8 +1004,8 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
           // block falling through air cross the face below its top into the cells the block
           // filled, where it stayed (a donor the block fills on its side gave nothing), and made
           // the air beneath it leave through ever less of the face below: at the first crossing
-          // the air reached 47-315 m/s, with no step refused. A rigid body keeps the donor's layer
-          // (it closes faces in faceVelocities too).
+          // the air reached 47-315 m/s, with no step refused. A rigid body's part of the face is
+          // not in the room: faceVelocities closes it (below).
           // The layers see where a surface is, not where it goes within the step: behind the top of
           // a block falling through air the face it leaves stayed covered ~0.9 for the whole step
           // (its upper layer held 1e-2 of the block, the block moved three times as far), and the
@@ -1046,11 +1046,24 @@ void IceSolver<Dim>::fluidFaceFractions(const CellState<Dim>& state, double dt)
             for (int e = 0; e < Dim; ++e) speed2 += momentum[e] * momentum[e];
             if (mass > 0 && speed2 > 0) across_motion = math::abs(momentum[d]) / math::sqrt(speed2);
           }
+          // The rigid bodies' part of the face is closed to every fluid in faceVelocities already:
+          // its face velocities are the open part's times 1 − R (R: rigidClosedShare, the larger of
+          // the two sides' shares), so the fractions here are of the open part. What else closes
+          // the face on a donor's side (the deformable solids' cover, the cover over the step) is
+          // taken out of that open part. Counted as a share of the whole face instead (the room
+          // 1 − the donor's rigid share), the water of a cut cell left through a face of the bed's
+          // staircase as (1 − R)² of the flow, the water above it entered as 1 − R: the fractions of
+          // the two sides differed (0.5 and 1.0), the flux jumped where a slow flow along the
+          // staircase turned in the pressure correction and left a residual for a second outer
+          // iteration (doc/mpmice.md, "Cost"). Without a rigid body the room is 1 − closed, as it was.
+          const double rigid_closed = rigidClosedShare(n, roles, share, c);
+          const double open = 1.0 - rigid_closed;
           double keep[2];
           for (int side = 0; side < 2; ++side) {
             const double layers = rigid[side] + covered;
             const double closed = layers + across_motion * (math::min(layers, swept[side]) - layers);
-            const double room = closed < 1.0 ? 1.0 - closed : 0.0;
+            const double others = closed - rigid[side];  // closed by the deformable solids on this side
+            const double room = !(open > 0.0) ? 0.0 : others < open ? math::min(1.0, 1.0 - others / open) : 0.0;
             const LocalOrdinal donor = side == 0 ? l : c;
             const bool fill = donor_solid[side] > kSolidPresent && fluid[side] > kFillMinimum;
             keep[side] = fluid[side] > 0 && (fill || fluid[side] > room) ? room / fluid[side] : 1.0;

@@ -338,9 +338,9 @@ RCP<ParameterList> buildMaterial(const std::string& kind)
            "equation solved for, with the solid's motion in it: a body lighter than the fluid moves mostly by "
            "it), or `reference`, the still fluid's hydrostatic pressure, moved with the fluids' pressure where it "
            "changes everywhere alike (its gradient is the buoyancy), for a "
-           "body whose particles shear off their lattice, so that their boxes cover a cell only to ~1 % and the "
-           "bulk modulus turns that into pressure noise (doc/mpmice.md, \"The pressure that acts where a solid "
-           "fills the cell\"). Not used by a rigid body; with `mpm.coupling: staggered` every deformable solid takes "
+           "body whose particles shear off their lattice or that turns (a floating or tumbling block), so that "
+           "their boxes cover a cell only to 1-4 % and the bulk modulus turns that into pressure (doc/mpmice.md, "
+           "\"The pressure that acts where a solid fills the cell\", \"A body that turns\"). Not used by a rigid body; with `mpm.coupling: staggered` every deformable solid takes "
            "`reference` (that pressure equation holds no response of the solids).",
            derivedDefault(oneOf({"cell", "reference"}),
                           "`reference` for the plastic models (tresca, drucker_prager), `cell` for the elastic ones"));

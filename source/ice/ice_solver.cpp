@@ -139,19 +139,23 @@ KOKKOS_INLINE_FUNCTION double followMixtureVelocity(int n, const Density& rho, c
 // own. (On faces it takes no part in the exchange; faceVelocities closes its share of the face.)
 constexpr double kRigidInertia = 1e30;
 
-// The exchange coefficients between every pair: the scene's K between fluids and between a fluid
-// and a solid; zero between two solids (MPM's contact acts between them, with friction and free
-// separation; a drag would make a sliding body stick to the bed).
+// The exchange coefficients between every pair: the scene's K between fluids, its solid K between
+// a fluid and a solid; zero between two solids (MPM's contact acts between them, with friction and
+// free separation; a drag would make a sliding body stick to the bed).
 // On faces a rigid body takes no part in the exchange: it closes the share of the face it covers
 // instead (faceVelocities), so that fluid still flows through the open part of a cut cell's face.
-ice::ExchangeCoefficients pairCoefficients(double coefficient, int materials, const MaterialRoles& roles,
+ice::ExchangeCoefficients pairCoefficients(const IceSettings& settings, int materials, const MaterialRoles& roles,
                                            bool on_faces = false)
 {
-  ice::ExchangeCoefficients K = ice::ExchangeCoefficients::uniform(coefficient);
+  ice::ExchangeCoefficients K = ice::ExchangeCoefficients::uniform(settings.exchange_coefficient);
   for (int m = 0; m < materials; ++m)
-    for (int n = 0; n < materials; ++n)
-      if (m != n && ((roles.lagrangian[m] && roles.lagrangian[n]) || (on_faces && (roles.rigid[m] || roles.rigid[n]))))
+    for (int n = 0; n < materials; ++n) {
+      if (m == n) continue;
+      if ((roles.lagrangian[m] && roles.lagrangian[n]) || (on_faces && (roles.rigid[m] || roles.rigid[n])))
         K.set(m, n, 0.0);
+      else if (roles.solid(m) != roles.solid(n))
+        K.set(m, n, settings.solid_exchange_coefficient);
+    }
   return K;
 }
 
@@ -255,6 +259,7 @@ IceSettings IceSettings::fromScene(const Scene& scene)
   s.heat_exchange_coefficient = ice.get<double>("heat_exchange_coefficient");
   s.pressure = ice.get<std::string>("pressure");
   s.exchange_coefficient = ice.get<double>("exchange_coefficient");
+  s.solid_exchange_coefficient = ice.get<double>("solid_exchange_coefficient");
   s.max_outer_iterations = ice.get<int>("max_outer_iterations");
   s.outer_tolerance = ice.get<double>("outer_tolerance");
   // solver_tolerance 0: each solve's target follows from outer_tolerance; 1e-10 relative is then
@@ -657,7 +662,7 @@ void IceSolver<Dim>::faceVelocities(const CellState<Dim>& state, double dt)
   const auto v = state.specific_volume.view();
   const auto p = state.pressure.view();
   const auto roles = faceRoles();
-  const auto K = pairCoefficients(settings_.exchange_coefficient, n, roles, true);
+  const auto K = pairCoefficients(settings_, n, roles, true);
   const bool with_solids = roles_.any_solid;
   const auto particle_volume = solid_particle_volume_.view();
   const auto closed = closed_;
@@ -1682,7 +1687,7 @@ void IceSolver<Dim>::exchangePhase(CellState<Dim>& state, double dt, IceStepRepo
   const auto theta = state.volume_fraction.view();
   const auto rho = state.density.view();
   const auto v = state.specific_volume.view();
-  const auto K = pairCoefficients(settings_.exchange_coefficient, n, roles_);
+  const auto K = pairCoefficients(settings_, n, roles_);
   const auto roles = roles_;
   const auto ijk = layout_->cellIndex();
   const long long nx = layout_->grid().cells()[0], ny = layout_->grid().cells()[1];
@@ -2193,14 +2198,16 @@ void IceSolver<Dim>::advectionPhase(CellState<Dim>& state, double dt, IceStepRep
   }
 }
 
-// Σ_n θ_n(c) over the materials n other than m.
+// Σ_k K_mk θ_k(c) over the materials k other than m: K between two fluids or two solids, K_s
+// between a fluid and a solid (the scene's two exchange coefficients).
 template <class Fractions>
-KOKKOS_INLINE_FUNCTION double othersShare(const Fractions& theta, LocalOrdinal c, int m, int n)
+KOKKOS_INLINE_FUNCTION double exchangeTie(const Fractions& theta, const MaterialRoles& roles, double K, double K_s,
+                                          LocalOrdinal c, int m, int n)
 {
-  double others = 0;
+  double alike = 0, unlike = 0;
   for (int k = 0; k < n; ++k)
-    if (k != m) others += theta(c, k);
-  return others;
+    if (k != m) (roles.solid(k) == roles.solid(m) ? alike : unlike) += theta(c, k);
+  return K * alike + K_s * unlike;
 }
 // What material m in cell c limits stableTimeStep by (0 where it does not limit; it limits only where
 // present, θ > 1e-6): its convective rate max_d |u_d| / h_d ...
@@ -2214,14 +2221,15 @@ KOKKOS_INLINE_FUNCTION double convectiveRate(const Velocities& u, const Fraction
   return rate;
 }
 // ... and its specific volume v, whose μ v and k v / c_v set the viscous and conduction limits, except
-// where the exchange holds it to the others of its cell within the step, Δt v K Σ_n θ_n > 1
+// where the exchange holds it to the others of its cell within the step, Δt v Σ_n K_mn θ_n > 1
 // (stableTimeStep).
 template <class Fractions, class Volumes>
-KOKKOS_INLINE_FUNCTION double diffusiveVolume(const Fractions& theta, const Volumes& v, double previous_dt, double K,
-                                              LocalOrdinal c, int m, int n)
+KOKKOS_INLINE_FUNCTION double diffusiveVolume(const Fractions& theta, const Volumes& v, double previous_dt,
+                                              const MaterialRoles& roles, double K, double K_s, LocalOrdinal c,
+                                              int m, int n)
 {
   if (theta(c, m) < 1e-6) return 0.0;
-  if (previous_dt * v(c, m) * K * othersShare(theta, c, m, n) > 1.0) return 0.0;
+  if (previous_dt * v(c, m) * exchangeTie(theta, roles, K, K_s, c, m, n) > 1.0) return 0.0;
   return v(c, m);
 }
 
@@ -2250,19 +2258,20 @@ TimeStepLimit IceSolver<Dim>::stableTimeStep(const CellState<Dim>& state, double
           if (s > worst) worst = s;
         },
         Kokkos::Max<double>(rate));
-    // A material that the exchange holds to the others of its cell within the step (β = Δt v_m K
-    // Σ_n θ_n above 1) does not limit the viscous step: its explicit viscous change is the force
+    // A material that the exchange holds to the others of its cell within the step (β = Δt v_m
+    // Σ_n K_mn θ_n above 1) does not limit the viscous step: its explicit viscous change is the force
     // θ μ ∇²u on it whatever its density, and the exchange gives it the mixture's velocity. (Air
     // expanded into a gap of the sand's cells, at tens of Pa, had ν = μ v ~ 0.1 m²/s and a viscous
     // step of 1e-6 s.) Σ_n θ_n over the other materials, not 1 − θ_m: a trace of boiling water
     // advected into a cell of sand at ~0 Pa (its specific volume ~1e12 m³/kg) closed to θ = 1.28
     // there until the next equilibration, 1 − θ_m was negative, and its viscous step of 9e-15 s
     // held the run at time.dt_min (a Drucker-Prager column collapsing under water, 0.191 s).
-    const double K = settings_.exchange_coefficient;
+    const double K = settings_.exchange_coefficient, K_s = settings_.solid_exchange_coefficient;
+    const auto roles = roles_;
     Kokkos::parallel_reduce(
         "ice::viscousLimit", Kokkos::RangePolicy<ExecutionSpace>(0, state.velocity.ownedCount()),
         KOKKOS_LAMBDA(const LocalOrdinal c, double& worst) {
-          const double volume = diffusiveVolume(theta, v, previous_dt, K, c, m, n);
+          const double volume = diffusiveVolume(theta, v, previous_dt, roles, K, K_s, c, m, n);
           if (volume > worst) worst = volume;
         },
         Kokkos::Max<double>(max_nu));
@@ -2305,7 +2314,8 @@ std::string IceSolver<Dim>::limitingCell(const CellState<Dim>& state, int m, int
   const auto v = state.specific_volume.view();
   double inv_h[3];
   for (int d = 0; d < Dim; ++d) inv_h[d] = 1.0 / layout_->grid().spacing()[d];
-  const double K = settings_.exchange_coefficient;
+  const double K = settings_.exchange_coefficient, K_s = settings_.solid_exchange_coefficient;
+  const auto roles = roles_;
   const int n = materials_;
   using Location = Kokkos::MaxLoc<double, LocalOrdinal>;
   typename Location::value_type local;
@@ -2313,7 +2323,7 @@ std::string IceSolver<Dim>::limitingCell(const CellState<Dim>& state, int m, int
       "ice::limitingCell", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
       KOKKOS_LAMBDA(const LocalOrdinal c, typename Location::value_type& best) {
         const double a = kind == 0 ? convectiveRate<Dim>(u, theta, inv_h, c, m)
-                                   : diffusiveVolume(theta, v, previous_dt, K, c, m, n);
+                                   : diffusiveVolume(theta, v, previous_dt, roles, K, K_s, c, m, n);
         if (a > best.val) best.val = a, best.loc = c;
       },
       Location(local));

@@ -40,7 +40,8 @@ struct IceSettings {
   bool isothermal = false;               // true: temperatures keep their values (no energy equation)
   double heat_exchange_coefficient = 0;  // H between every pair of materials (W/(m^3 K))
   std::string pressure;                  // "implicit" or "explicit" (for comparison)
-  double exchange_coefficient = 0;       // momentum exchange K between every pair (kg/(m^3 s))
+  double exchange_coefficient = 0;       // momentum exchange K between every pair of fluids (kg/(m^3 s))
+  double solid_exchange_coefficient = 0; // ... between a solid and a fluid
   int max_outer_iterations = 0;
   double outer_tolerance = 0;            // on the pressure equation's residual, a volume share (IceSolver::pressureRightHandSide)
   double solver_tolerance = 0;           // relative residual of each linear solve (when given)

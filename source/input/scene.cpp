@@ -1094,6 +1094,12 @@ Scene readSceneText(const std::string& file_text, const std::string& path)
     // 2. The top level: known sections of the right type, required ones present, optional ones added.
     const ParameterList& valid = *validSceneParameters();
     checkKeys(*root, valid, kRoot, 0);
+    // The solid-fluid exchange coefficient follows the scene's exchange coefficient unless given.
+    if (root->isSublist("ice")) {
+      ParameterList& ice = root->sublist("ice");
+      if (!ice.isParameter("solid_exchange_coefficient") && ice.isParameter("exchange_coefficient"))
+        ice.set("solid_exchange_coefficient", ice.get<double>("exchange_coefficient"));
+    }
     setDefaults(*root, valid, kRoot);
 
     // 3. Each section, the domain first (its dimension sets the length of per-direction lists),

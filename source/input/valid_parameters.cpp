@@ -259,8 +259,17 @@ void defineIce(ParameterList& ice)
          atLeast(0, "W/(m^3 K)"));
   define(ice, "pressure", std::string("implicit"), "Pressure scheme; `explicit` is for comparison only.",
          oneOf({"implicit", "explicit"}));
-  define(ice, "exchange_coefficient", 1.0e15, "Momentum exchange K between every pair of materials.",
+  define(ice, "exchange_coefficient", 1.0e15,
+         "Momentum exchange K between every pair of materials (between a solid and a fluid: "
+         "`solid_exchange_coefficient`). 0 leaves a trace of one fluid in the cells of another free of it: "
+         "air in water's cells then accelerates at its own v ∇p.",
          atLeast(0, "kg/(m^3 s)"));
+  define(ice, "solid_exchange_coefficient", 1.0e15,
+         "Momentum exchange K between a solid and a fluid, in the cells and on the faces they share (two "
+         "solids: none; MPM's contact acts between them). 0: the fluids slip along the solids, which the "
+         "pressure alone moves (potential flow's added mass), while the fluids stay tied to each other by "
+         "`exchange_coefficient`.",
+         derivedDefault(atLeast(0, "kg/(m^3 s)"), "`exchange_coefficient`'s value"));
   define(ice, "max_outer_iterations", 20, "Outer iterations of the pressure equation per step at most.", atLeast(1));
   define(ice, "outer_tolerance", 1.0e-8,
          "The outer iterations stop once max |rhs| / V of the pressure equation is below this: the volume "

@@ -562,6 +562,34 @@ TEST(CoupledStep, ParticleStepsInsideAFluidStepConserveMomentum)
   EXPECT_NEAR(imbalance, 0.0, 1e-10);
 }
 
+// `ice.solid_exchange_coefficient` is the K between a solid and a fluid, apart from the fluids' own
+// `exchange_coefficient`. In the added-mass disk's tank of water alone the only pair is the disk's
+// with the water, so the key alone at 0 (the fluids' K left at its default, 1e15) must step exactly
+// as `exchange_coefficient: 0` does, bit for bit (the face and the cell exchange, and the viscous
+// limit, take it); left out, it follows `exchange_coefficient`, and the default K = 1e15 holds the
+// water of the disk's boundary cells to it, which changes the disk's velocity at the first step.
+TEST(CoupledStep, ExchangeWithSolidsHasItsOwnCoefficient)
+{
+  const auto diskVelocityAfter = [](const std::string& exchange, int steps) {
+    std::string text = addedMassDiskScene(500.0, 10);
+    text.replace(text.find("  ice: {exchange_coefficient: 0.0}"), 34, "  ice: " + exchange);
+    CoupledRun<2> run(sceneFromYaml(text), world());
+    for (int k = 0; k < steps; ++k) run.step(1.0);
+    return run.meanParticleVelocity(0, 1);
+  };
+  const int steps = 20;
+  const double fluids_and_solids_zero = diskVelocityAfter("{exchange_coefficient: 0.0}", steps);
+  const double solids_zero = diskVelocityAfter("{solid_exchange_coefficient: 0.0}", steps);
+  const double follows = diskVelocityAfter("{}", steps);
+  if (world()->getRank() == 0)
+    std::printf("disk velocity after %d steps: K = 0 %.17g, solid K = 0 %.17g, default %.17g\n", steps,
+                fluids_and_solids_zero, solids_zero, follows);
+  EXPECT_EQ(solids_zero, fluids_and_solids_zero);
+  // The boundary ring's water (~h/2 around the disk, a fifth of the disk's mass at 10 cells per
+  // diameter) slows it by far more than round-off.
+  EXPECT_GT(std::abs(follows - fluids_and_solids_zero), 1e-3 * std::abs(fluids_and_solids_zero));
+}
+
 // No silent failures: a cell whose materials admit no common pressure (here air at a temperature
 // below zero, whose ideal-gas density has no positive root, next to water) stops the step with the
 // cell named, as a failed step that the driver can retry (StepFailure), not a pressure left

@@ -268,7 +268,8 @@ void defineIce(ParameterList& ice)
          "Momentum exchange K between a solid and a fluid, in the cells and on the faces they share (two "
          "solids: none; MPM's contact acts between them). 0: the fluids slip along the solids, which the "
          "pressure alone moves (potential flow's added mass), while the fluids stay tied to each other by "
-         "`exchange_coefficient`.",
+         "`exchange_coefficient`; a fluid alone with a solid in a cell (the air in a floating body's cells "
+         "above the water) is then held by nothing and may race (doc/mpmice.md, \"Exchange\").",
          derivedDefault(atLeast(0, "kg/(m^3 s)"), "`exchange_coefficient`'s value"));
   define(ice, "max_outer_iterations", 20, "Outer iterations of the pressure equation per step at most.", atLeast(1));
   define(ice, "outer_tolerance", 1.0e-8,

@@ -2198,16 +2198,15 @@ void IceSolver<Dim>::advectionPhase(CellState<Dim>& state, double dt, IceStepRep
   }
 }
 
-// Σ_k K_mk θ_k(c) over the materials k other than m: K between two fluids or two solids, K_s
-// between a fluid and a solid (the scene's two exchange coefficients).
+// Σ_k K_mk θ_k(c) over the materials k other than m (K: the cells' pairCoefficients).
 template <class Fractions>
-KOKKOS_INLINE_FUNCTION double exchangeTie(const Fractions& theta, const MaterialRoles& roles, double K, double K_s,
-                                          LocalOrdinal c, int m, int n)
+KOKKOS_INLINE_FUNCTION double exchangeTie(const Fractions& theta, const ice::ExchangeCoefficients& K, LocalOrdinal c,
+                                          int m, int n)
 {
-  double alike = 0, unlike = 0;
+  double tie = 0;
   for (int k = 0; k < n; ++k)
-    if (k != m) (roles.solid(k) == roles.solid(m) ? alike : unlike) += theta(c, k);
-  return K * alike + K_s * unlike;
+    if (k != m) tie += K(m, k) * theta(c, k);
+  return tie;
 }
 // What material m in cell c limits stableTimeStep by (0 where it does not limit; it limits only where
 // present, θ > 1e-6): its convective rate max_d |u_d| / h_d ...
@@ -2225,11 +2224,10 @@ KOKKOS_INLINE_FUNCTION double convectiveRate(const Velocities& u, const Fraction
 // (stableTimeStep).
 template <class Fractions, class Volumes>
 KOKKOS_INLINE_FUNCTION double diffusiveVolume(const Fractions& theta, const Volumes& v, double previous_dt,
-                                              const MaterialRoles& roles, double K, double K_s, LocalOrdinal c,
-                                              int m, int n)
+                                              const ice::ExchangeCoefficients& K, LocalOrdinal c, int m, int n)
 {
   if (theta(c, m) < 1e-6) return 0.0;
-  if (previous_dt * v(c, m) * exchangeTie(theta, roles, K, K_s, c, m, n) > 1.0) return 0.0;
+  if (previous_dt * v(c, m) * exchangeTie(theta, K, c, m, n) > 1.0) return 0.0;
   return v(c, m);
 }
 
@@ -2249,6 +2247,7 @@ TimeStepLimit IceSolver<Dim>::stableTimeStep(const CellState<Dim>& state, double
   }
   const double cfl = scene_.time.cfl;
   std::vector<double> local(3 * n, DBL_MAX), global(3 * n);
+  const auto K = pairCoefficients(settings_, n, roles_);
   for (int m = 0; m < n; ++m) {
     double rate = 0, max_nu = 0;
     Kokkos::parallel_reduce(
@@ -2266,12 +2265,10 @@ TimeStepLimit IceSolver<Dim>::stableTimeStep(const CellState<Dim>& state, double
     // advected into a cell of sand at ~0 Pa (its specific volume ~1e12 m³/kg) closed to θ = 1.28
     // there until the next equilibration, 1 − θ_m was negative, and its viscous step of 9e-15 s
     // held the run at time.dt_min (a Drucker-Prager column collapsing under water, 0.191 s).
-    const double K = settings_.exchange_coefficient, K_s = settings_.solid_exchange_coefficient;
-    const auto roles = roles_;
     Kokkos::parallel_reduce(
         "ice::viscousLimit", Kokkos::RangePolicy<ExecutionSpace>(0, state.velocity.ownedCount()),
         KOKKOS_LAMBDA(const LocalOrdinal c, double& worst) {
-          const double volume = diffusiveVolume(theta, v, previous_dt, roles, K, K_s, c, m, n);
+          const double volume = diffusiveVolume(theta, v, previous_dt, K, c, m, n);
           if (volume > worst) worst = volume;
         },
         Kokkos::Max<double>(max_nu));
@@ -2314,16 +2311,15 @@ std::string IceSolver<Dim>::limitingCell(const CellState<Dim>& state, int m, int
   const auto v = state.specific_volume.view();
   double inv_h[3];
   for (int d = 0; d < Dim; ++d) inv_h[d] = 1.0 / layout_->grid().spacing()[d];
-  const double K = settings_.exchange_coefficient, K_s = settings_.solid_exchange_coefficient;
-  const auto roles = roles_;
   const int n = materials_;
+  const auto K = pairCoefficients(settings_, n, roles_);
   using Location = Kokkos::MaxLoc<double, LocalOrdinal>;
   typename Location::value_type local;
   Kokkos::parallel_reduce(
       "ice::limitingCell", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
       KOKKOS_LAMBDA(const LocalOrdinal c, typename Location::value_type& best) {
         const double a = kind == 0 ? convectiveRate<Dim>(u, theta, inv_h, c, m)
-                                   : diffusiveVolume(theta, v, previous_dt, roles, K, K_s, c, m, n);
+                                   : diffusiveVolume(theta, v, previous_dt, K, c, m, n);
         if (a > best.val) best.val = a, best.loc = c;
       },
       Location(local));

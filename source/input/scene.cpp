@@ -833,6 +833,18 @@ ParameterList& checkedSection(ParameterList& list, const std::string& name)
   return list;
 }
 
+/// The `ice` section, read by the ICE solver: checked as a fixed section, with the solid-fluid
+/// exchange coefficient following the fluids' unless given.
+void checkIce(ParameterList& list)
+{
+  const std::string path = kRoot + ".ice";
+  const ParameterList& valid = validSceneParameters()->sublist("ice");
+  checkKeys(list, valid, path, 0);
+  if (!list.isParameter("solid_exchange_coefficient") && list.isParameter("exchange_coefficient"))
+    list.set("solid_exchange_coefficient", list.get<double>("exchange_coefficient"));
+  setDefaults(list, valid, path);
+}
+
 InitialStateSpec readInitialState(ParameterList& list, const std::vector<MaterialSpec>& materials)
 {
   const std::string path = kRoot + ".initial_state";
@@ -1094,12 +1106,6 @@ Scene readSceneText(const std::string& file_text, const std::string& path)
     // 2. The top level: known sections of the right type, required ones present, optional ones added.
     const ParameterList& valid = *validSceneParameters();
     checkKeys(*root, valid, kRoot, 0);
-    // The solid-fluid exchange coefficient follows the scene's exchange coefficient unless given.
-    if (root->isSublist("ice")) {
-      ParameterList& ice = root->sublist("ice");
-      if (!ice.isParameter("solid_exchange_coefficient") && ice.isParameter("exchange_coefficient"))
-        ice.set("solid_exchange_coefficient", ice.get<double>("exchange_coefficient"));
-    }
     setDefaults(*root, valid, kRoot);
 
     // 3. Each section, the domain first (its dimension sets the length of per-direction lists),
@@ -1114,7 +1120,7 @@ Scene readSceneText(const std::string& file_text, const std::string& path)
     scene.time = readTime(root->sublist("time"));
     scene.output = readOutput(root->sublist("output"));
     scene.mpm = readMpm(root->sublist("mpm"));
-    checkedSection(root->sublist("ice"), "ice");  // read by the ICE solver (IceSettings::fromScene)
+    checkIce(root->sublist("ice"));  // read by the ICE solver (IceSettings::fromScene)
 
     // 4. The scene as a whole: what the regions place, the solvers' own settings, derived
     //    quantities, the grid's size (input/scene_checks.hpp).

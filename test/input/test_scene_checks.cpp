@@ -147,6 +147,26 @@ TEST_F(SceneTest, LinearSolverKeysAreCheckedWithTheScene)
                  {"cfdmpm.ice.linear_solver.refresh corrections", "true or false"});
 }
 
+// ice.solid_exchange_coefficient follows ice.exchange_coefficient unless given, and a wrong type for
+// the one it follows is named as any other key's (it is read only after the section's keys pass).
+TEST_F(SceneTest, SolidExchangeCoefficientFollowsTheFluidsUnlessGiven)
+{
+  const auto coefficients = [&](const std::string& ice) {
+    const Scene scene = readScene(write(replaced(kFullScene, kIce, ice)));
+    const auto& list = scene.parameters->sublist("ice");
+    return std::pair{list.get<double>("exchange_coefficient"), list.get<double>("solid_exchange_coefficient")};
+  };
+  EXPECT_EQ(coefficients("  ice: {}\n"), (std::pair{1e15, 1e15}));
+  EXPECT_EQ(coefficients("  ice: {exchange_coefficient: 1.0e3}\n"), (std::pair{1e3, 1e3}));
+  EXPECT_EQ(coefficients("  ice: {exchange_coefficient: 0}\n"), (std::pair{0.0, 0.0}));
+  EXPECT_EQ(coefficients("  ice: {solid_exchange_coefficient: 0.0}\n"), (std::pair{1e15, 0.0}));
+  EXPECT_EQ(coefficients("  ice: {exchange_coefficient: 1.0e3, solid_exchange_coefficient: 5.0}\n"), (std::pair{1e3, 5.0}));
+  expectMentions(errorOf(replaced(kFullScene, kIce, "  ice: {exchange_coefficient: strong}\n")),
+                 {"cfdmpm.ice.exchange_coefficient", "strong", "a number"});
+  expectMentions(errorOf(replaced(kFullScene, kIce, "  ice: {solid_exchange_coefficient: -1}\n")),
+                 {"cfdmpm.ice.solid_exchange_coefficient", ">= 0"});
+}
+
 TEST_F(SceneTest, EnergyEquationWithSolidsIsRefusedWithTheScene)
 {
   // The coupled step does not carry the solids' temperature: the fluid solver refuses it, and so

@@ -571,8 +571,9 @@ TEST(CoupledStep, ParticleStepsInsideAFluidStepConserveMomentum)
 TEST(CoupledStep, ExchangeWithSolidsHasItsOwnCoefficient)
 {
   const auto diskVelocityAfter = [](const std::string& exchange, int steps) {
+    const std::string none = "  ice: {exchange_coefficient: 0.0}";  // addedMassDiskScene's
     std::string text = addedMassDiskScene(500.0, 10);
-    text.replace(text.find("  ice: {exchange_coefficient: 0.0}"), 34, "  ice: " + exchange);
+    text.replace(text.find(none), none.size(), "  ice: " + exchange);
     CoupledRun<2> run(sceneFromYaml(text), world());
     for (int k = 0; k < steps; ++k) run.step(1.0);
     return run.meanParticleVelocity(0, 1);

@@ -46,9 +46,15 @@ ParticleMigration<Dim>::ParticleMigration(const Layout<Dim>& layout)
 }
 
 template <int Dim>
-MigrationCounts ParticleMigration<Dim>::operator()(Particles<Dim>& particles, const std::string& local_error)
+MigrationCounts ParticleMigration<Dim>::operator()(Particles<Dim>& particles, const std::string& local_error,
+                                                   const Kokkos::View<int*, MemorySpace>& candidates,
+                                                   int candidate_count)
 {
   const int n = particles.count;
+  // The particles looked at: every one, or the candidates; index i of the range is particle
+  // every ? i : candidates(i), ascending either way.
+  const bool every = candidate_count < 0;
+  const int looked_at = every ? n : candidate_count;
   constexpr int K = Particles<Dim>::kPackedSize;
   ensureSize(destination_, n, "particle destination");
   ensureSize(slot_, n, "particle slot");
@@ -67,7 +73,8 @@ MigrationCounts ParticleMigration<Dim>::operator()(Particles<Dim>& particles, co
       cells[d] = cells_[d], patch_cells[d] = patch_cells_[d], patches[d] = patches_[d];
     }
     Kokkos::parallel_for(
-        "mpm::migration_destination", Kokkos::RangePolicy<ExecutionSpace>(0, n), KOKKOS_LAMBDA(const int p) {
+        "mpm::migration_destination", Kokkos::RangePolicy<ExecutionSpace>(0, looked_at), KOKKOS_LAMBDA(const int i) {
+          const int p = every ? i : candidates(i);
           long long c[3] = {0, 0, 0};
           for (int d = 0; d < Dim; ++d) {
             c[d] = static_cast<long long>(math::floor((position(p, d) - lower[d]) / spacing[d]));
@@ -96,8 +103,9 @@ MigrationCounts ParticleMigration<Dim>::operator()(Particles<Dim>& particles, co
   {
     const auto destination = destination_;
     Kokkos::parallel_reduce(
-        "mpm::migration_check", Kokkos::RangePolicy<ExecutionSpace>(0, n),
-        KOKKOS_LAMBDA(const int p, int& first) {
+        "mpm::migration_check", Kokkos::RangePolicy<ExecutionSpace>(0, looked_at),
+        KOKKOS_LAMBDA(const int i, int& first) {
+          const int p = every ? i : candidates(i);
           if (destination(p) == kOutsideDomain && p < first) first = p;
         },
         Kokkos::Min<int>(first_outside));
@@ -126,8 +134,9 @@ MigrationCounts ParticleMigration<Dim>::operator()(Particles<Dim>& particles, co
     const auto destination = destination_;
     const auto slot = slot_;
     Kokkos::parallel_scan(
-        "mpm::migration_scan", Kokkos::RangePolicy<ExecutionSpace>(0, n),
-        KOKKOS_LAMBDA(const int p, int& offset, const bool final) {
+        "mpm::migration_scan", Kokkos::RangePolicy<ExecutionSpace>(0, looked_at),
+        KOKKOS_LAMBDA(const int i, int& offset, const bool final) {
+          const int p = every ? i : candidates(i);
           const bool leaves = destination(p) >= 0;
           if (final && leaves) slot(p) = offset;
           if (leaves) ++offset;
@@ -140,7 +149,8 @@ MigrationCounts ParticleMigration<Dim>::operator()(Particles<Dim>& particles, co
     const auto slot = slot_;
     const auto leaving = leaving_;
     Kokkos::parallel_for(
-        "mpm::migration_list", Kokkos::RangePolicy<ExecutionSpace>(0, n), KOKKOS_LAMBDA(const int p) {
+        "mpm::migration_list", Kokkos::RangePolicy<ExecutionSpace>(0, looked_at), KOKKOS_LAMBDA(const int i) {
+          const int p = every ? i : candidates(i);
           if (destination(p) >= 0) leaving(slot(p)) = p;
         });
   }

@@ -28,7 +28,12 @@ class ParticleMigration {
   /// position in the message, the others name that rank. `local_error`, when not empty, is an error
   /// found earlier on this rank (e.g. an inverted particle) and is raised the same way, so that the
   /// step needs no extra collective for its checks.
-  MigrationCounts operator()(Particles<Dim>& particles, const std::string& local_error = "");
+  ///
+  /// With `candidate_count` >= 0 only the particles candidates(0 .. candidate_count - 1) (indices,
+  /// ascending) may have left their rank's cells: the others are known to stay (a rigid body at
+  /// rest), and are not looked at.
+  MigrationCounts operator()(Particles<Dim>& particles, const std::string& local_error = "",
+                             const Kokkos::View<int*, MemorySpace>& candidates = {}, int candidate_count = -1);
 
  private:
   MPI_Comm comm_;

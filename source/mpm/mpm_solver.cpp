@@ -256,6 +256,8 @@ MpmSolver<Dim>::MpmSolver(const Scene& scene, std::shared_ptr<const Layout<Dim>>
   empty_node_mass_ = kEmptyNodeMassFraction * smallest_particle;
 
   particles_ = seedParticles(scene, *layout_, materials_);
+  const MaterialTable table = materialTable(materials_);
+  for (int m = 0; m < table.count; ++m) any_stationary_ = any_stationary_ || table.stationary(m);
   allocateNodeFields();
   migration_ = std::make_unique<ParticleMigration<Dim>>(*layout_);
 }
@@ -279,7 +281,7 @@ template <int Dim>
 void MpmSolver<Dim>::repartition(std::shared_ptr<const Layout<Dim>> layout)
 {
   layout_ = std::move(layout);
-  stationary_nodes_.valid = stationary_cells_.valid = false;
+  particlesChanged();
   allocateNodeFields();
   migration_ = std::make_unique<ParticleMigration<Dim>>(*layout_);
   relocateParticles();
@@ -325,18 +327,90 @@ void MpmSolver<Dim>::gridToParticles(double dt)
 }
 
 template <int Dim>
-template <class F>
-void MpmSolver<Dim>::forEachParticleScattering(const char* label, const BoxLookup& lookup, const F& f)
+void MpmSolver<Dim>::particlesChanged()
 {
+  changing_current_ = false;
+  stationary_placed_ = false;
+  bins_current_ = false;
+  stationary_nodes_.valid = stationary_cells_.valid = false;
+}
+
+template <int Dim>
+void MpmSolver<Dim>::refreshChangingList() const
+{
+  if (changing_current_ || everyParticleChanges()) return;
+  const int n = particles_.count;
+  if (int(changing_.extent(0)) < n)
+    changing_ = Kokkos::View<int*, MemorySpace>(Kokkos::view_alloc(Kokkos::WithoutInitializing, "changing particles"),
+                                                std::size_t(n) * 3 / 2 + 16);
+  const MaterialTable table = materialTable(materials_);
+  const auto material = particles_.material;
+  const auto list = changing_;
+  int count = 0;
+  Kokkos::parallel_scan(
+      "mpm::changing_particles", Kokkos::RangePolicy<ExecutionSpace>(0, n),
+      KOKKOS_LAMBDA(const int p, int& offset, const bool final) {
+        if (table.stationary(material(p))) return;
+        if (final) list(offset) = p;
+        ++offset;
+      },
+      count);
+  changing_count_ = count;
+  changing_current_ = true;
+}
+
+template <int Dim>
+template <class F>
+void MpmSolver<Dim>::forEachParticle(const char* label, ParticleSet set, const F& f) const
+{
+  if (set == ParticleSet::All || everyParticleChanges()) {
+    Kokkos::parallel_for(label, Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count), f);
+    return;
+  }
+  refreshChangingList();
+  const auto list = changing_;
+  Kokkos::parallel_for(
+      label, Kokkos::RangePolicy<ExecutionSpace>(0, changing_count_), KOKKOS_LAMBDA(const int i) { f(list(i)); });
+}
+
+template <int Dim>
+template <class F, class Reducer>
+void MpmSolver<Dim>::reduceOverParticles(const char* label, ParticleSet set, const F& f, const Reducer& reducer) const
+{
+  if (set == ParticleSet::All || everyParticleChanges()) {
+    Kokkos::parallel_reduce(label, Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count), f, reducer);
+    return;
+  }
+  refreshChangingList();
+  const auto list = changing_;
+  Kokkos::parallel_reduce(
+      label, Kokkos::RangePolicy<ExecutionSpace>(0, changing_count_),
+      KOKKOS_LAMBDA(const int i, typename Reducer::value_type& value) { f(list(i), value); }, reducer);
+}
+
+template <int Dim>
+template <class F>
+void MpmSolver<Dim>::forEachParticleScattering(const char* label, const BoxLookup& lookup, ParticleSet set,
+                                               const F& f)
+{
+  if (everyParticleChanges()) set = ParticleSet::All;
   // One thread adds particle by particle; more threads go tile colour by tile colour, so that no
   // two threads add into the same node (ParticleBins; no atomics, no per-thread copies).
   const int threads = ExecutionSpace().concurrency();
   if (threads > 1) {
-    if (!bins_current_) bins_.build(particles_, layout_->grid(), lookup, threads);
+    if (!bins_current_ || bins_set_ != set) {
+      if (set == ParticleSet::All) {
+        bins_.build(particles_, layout_->grid(), lookup, threads);
+      } else {
+        refreshChangingList();
+        bins_.build(particles_, layout_->grid(), lookup, threads, changing_, changing_count_);
+      }
+      bins_set_ = set;
+    }
     bins_current_ = true;
     bins_.forEachParticle(f);
   } else {
-    Kokkos::parallel_for(label, Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count), f);
+    forEachParticle(label, set, f);
   }
 }
 
@@ -350,7 +424,7 @@ void MpmSolver<Dim>::scatterWithStationarySums(const char* label, const BoxLooku
   for (int m = 0; m < table.count; ++m) any = any || table.stationary(m);
   if (!options_.stationary_sums_once || !any) {
     sums.fill(0.0);
-    forEachParticleScattering(label, lookup, f);
+    forEachParticleScattering(label, lookup, ParticleSet::All, f);
     return;
   }
   // A bed at rest holds most of a slide's particles (91 % at 5 mm) and adds the same at every
@@ -382,10 +456,7 @@ void MpmSolver<Dim>::scatterWithStationarySums(const char* label, const BoxLooku
   } else {
     Kokkos::deep_copy(values, stationary.values);
   }
-  const auto material = particles_.material;
-  forEachParticleScattering(label, lookup, KOKKOS_LAMBDA(const int p) {
-    if (!table.stationary(material(p))) f(p);
-  });
+  forEachParticleScattering(label, lookup, ParticleSet::Changing, f);
 }
 
 /// P2G: m_i = sum_p w_ip m_p, (mv)_i = sum_p w_ip m_p v_p,
@@ -574,7 +645,7 @@ void MpmSolver<Dim>::gridToParticlesWith(double dt)
       }
     };
     // The same scatter order as in particlesToGridWith (its bins still hold: no particle moved).
-    forEachParticleScattering("mpm::grid_to_particles_velocity", lookup, update);
+    forEachParticleScattering("mpm::grid_to_particles_velocity", lookup, ParticleSet::Changing, update);
     node_velocity_new_->sumToOwners();
     // The contact and wall conditions on u. They were decided once, on v*, in this step: the
     // particles move with v*, so a node that v* held against a wall, a rigid body or another
@@ -625,8 +696,8 @@ void MpmSolver<Dim>::gridToParticlesWith(double dt)
   const bool moved_apart = options_.move_before_coupling && node_velocity_moved_;
   const auto node_moved = moved_apart ? node_velocity_moved_->view() : node_vs;
 
-  Kokkos::parallel_for(
-      "mpm::grid_to_particles", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count), KOKKOS_LAMBDA(const int p) {
+  forEachParticle(
+      "mpm::grid_to_particles", ParticleSet::Changing, KOKKOS_LAMBDA(const int p) {
         const int m = material(p);
         if (table.rigid[m]) {
           for (int d = 0; d < Dim; ++d) {
@@ -826,8 +897,8 @@ void MpmSolver<Dim>::startOwnMotion()
   const auto v = particles_.velocity;
   const auto change = particles_.velocity_change;
   const auto mark = particles_.own_acceleration;  // holds the mark until recordOwnAcceleration
-  Kokkos::parallel_for(
-      "mpm::start_own_motion", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count), KOKKOS_LAMBDA(const int p) {
+  forEachParticle(
+      "mpm::start_own_motion", ParticleSet::Changing, KOKKOS_LAMBDA(const int p) {
         for (int d = 0; d < Dim; ++d) mark(p, d) = v(p, d) + change(p, d);
       });
 }
@@ -837,9 +908,8 @@ void MpmSolver<Dim>::recordOwnAcceleration(double dt)
 {
   const auto v = particles_.velocity;
   const auto a = particles_.own_acceleration;
-  Kokkos::parallel_for(
-      "mpm::record_own_acceleration", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count),
-      KOKKOS_LAMBDA(const int p) {
+  forEachParticle(
+      "mpm::record_own_acceleration", ParticleSet::Changing, KOKKOS_LAMBDA(const int p) {
         for (int d = 0; d < Dim; ++d) a(p, d) = (v(p, d) - a(p, d)) / dt;
       });
 }
@@ -869,9 +939,8 @@ void MpmSolver<Dim>::cellVelocityChangeToParticles(const Field<Dim>& change)
   long long count[Dim];
   for (int d = 0; d < Dim; ++d)
     origin[d] = grid.lower()[d], spacing[d] = grid.spacing()[d], count[d] = grid.cells()[d];
-  Kokkos::parallel_for(
-      "mpm::cell_velocity_change_to_particles", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count),
-      KOKKOS_LAMBDA(const int p) {
+  forEachParticle(
+      "mpm::cell_velocity_change_to_particles", ParticleSet::Changing, KOKKOS_LAMBDA(const int p) {
         const int m = material(p);
         double xp[Dim], lp[Dim], change_p[Dim] = {};
         for (int d = 0; d < Dim; ++d) xp[d] = x(p, d), lp[d] = half_width(p, d);
@@ -934,7 +1003,7 @@ void MpmSolver<Dim>::particleVelocityChangeToNodesWith(double fraction)
       for (int d = 0; d < Dim; ++d) dmv(lid, m * Dim + d) += s.weight[k] * mp * dv[d];
     }
   };
-  forEachParticleScattering("mpm::particle_velocity_change", nodes, scatter);
+  forEachParticleScattering("mpm::particle_velocity_change", nodes, ParticleSet::Changing, scatter);
   node_momentum_change_->sumToOwners();
 }
 
@@ -1186,7 +1255,7 @@ void MpmSolver<Dim>::predictCellVolumesWith(const Field<Dim>& change, double dt,
     particleGridVelocity<Dim, Kernel>(xp, lp, m, table, origin, spacing, nodes, node_u, velocity);
     addMovedBox<Dim>(xp, lp, velocity, dt, fluidsVolume(volume(p), history(p)), origin, spacing, count, cells, out, m);
   };
-  forEachParticleScattering("mpm::predict_cell_volumes", nodes, scatter);
+  forEachParticleScattering("mpm::predict_cell_volumes", nodes, ParticleSet::All, scatter);
   volumes.sumToOwners();
 }
 
@@ -1204,8 +1273,8 @@ void MpmSolver<Dim>::updateStress(double dt)
 
   // An inverted particle (det F <= 0) means the step was too large or the mesh too coarse.
   int inverted = n;
-  Kokkos::parallel_reduce(
-      "mpm::check_jacobian", Kokkos::RangePolicy<ExecutionSpace>(0, n),
+  reduceOverParticles(
+      "mpm::check_jacobian", ParticleSet::Changing,
       KOKKOS_LAMBDA(const int p, int& first) {
         Mat<Dim> Fp;
         for (int d = 0; d < Dim; ++d)
@@ -1227,10 +1296,12 @@ void MpmSolver<Dim>::updateStress(double dt)
     if (pending_error_.empty()) pending_error_ = message.str();
   }
 
+  const MaterialTable table = materialTable(materials_);
   for (int a = 0; a < int(materials_.size()); ++a) {
+    if (table.stationary(a)) continue;  // a rigid body at rest: nothing to update
     materials_[a].model.visit([&](const auto& model) {
-      Kokkos::parallel_for(
-          "mpm::stress_update", Kokkos::RangePolicy<ExecutionSpace>(0, n), KOKKOS_LAMBDA(const int p) {
+      forEachParticle(
+          "mpm::stress_update", ParticleSet::Changing, KOKKOS_LAMBDA(const int p) {
             if (material(p) != a) return;
             StepKinematics<Dim> kinematics;
             Mat<Dim> stress;
@@ -1257,7 +1328,16 @@ MigrationCounts MpmSolver<Dim>::relocateParticles()
   const std::string error = pending_error_;
   pending_error_.clear();
   bins_current_ = false;
-  return (*migration_)(particles_, error);
+  MigrationCounts counts;
+  if (stationary_placed_ && !everyParticleChanges()) {
+    refreshChangingList();  // the particles of rigid bodies at rest have not moved since
+    counts = (*migration_)(particles_, error, changing_, changing_count_);
+  } else {
+    counts = (*migration_)(particles_, error);
+  }
+  stationary_placed_ = true;
+  if (counts.sent > 0 || counts.received > 0) changing_current_ = false;  // particles left, came or moved
+  return counts;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1287,8 +1367,7 @@ void MpmSolver<Dim>::restoreParticles(const ParticleSnapshot& snapshot, int coun
       KOKKOS_LAMBDA(const int p) { particles.unpack(&snapshot(p, 0), p); });
   Kokkos::fence();
   pending_error_.clear();
-  bins_current_ = false;
-  stationary_nodes_.valid = stationary_cells_.valid = false;
+  particlesChanged();
 }
 
 namespace {
@@ -1326,8 +1405,9 @@ std::string MpmSolver<Dim>::nonFiniteParticle() const
   const Particles<Dim> particles = particles_;
   const int n = particles.count;
   long long lowest = LLONG_MAX, global_lowest = LLONG_MAX;
-  Kokkos::parallel_reduce(
-      "mpm::nonFiniteParticle", Kokkos::RangePolicy<ExecutionSpace>(0, n),
+  // A particle a step does not change stays as it was seeded (or restored, and then checked).
+  reduceOverParticles(
+      "mpm::nonFiniteParticle", ParticleSet::Changing,
       KOKKOS_LAMBDA(const int p, long long& found) {
         if (nonFiniteQuantity(particles, p) >= 0 && particles.id(p) < found) found = particles.id(p);
       },
@@ -1380,17 +1460,18 @@ MpmTimeStep MpmSolver<Dim>::stableTimeStep() const
   const auto mass = particles_.mass;
   const auto volume = particles_.volume;
   const auto material = particles_.material;
-  const int n = particles_.count;
+  const MaterialTable table = materialTable(materials_);
 
   using MaxLoc = Kokkos::MaxLoc<double, int>;
   // Largest signal speed c + |v| (>= 0) and its particle; the reducer starts from -DBL_MAX.
   double fastest_value = -1.0;
   int fastest_particle = -1, fastest_material = -1;
   for (int a = 0; a < int(materials_.size()); ++a) {
+    if (table.stationary(a)) continue;  // a rigid body at rest has no signal speed
     typename MaxLoc::value_type found;
     materials_[a].model.visit([&](const auto& model) {
-      Kokkos::parallel_reduce(
-          "mpm::signal_speed", Kokkos::RangePolicy<ExecutionSpace>(0, n),
+      reduceOverParticles(
+          "mpm::signal_speed", ParticleSet::Changing,
           KOKKOS_LAMBDA(const int p, typename MaxLoc::value_type& best) {
             if (material(p) != a) return;
             double speed2 = 0.0;

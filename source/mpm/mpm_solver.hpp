@@ -230,8 +230,14 @@ class MpmSolver {
   // --- access ------------------------------------------------------------------------------------
   const std::vector<SolidMaterial>& materials() const { return materials_; }
   const MpmOptions& options() const { return options_; }
+  /// The particles, to read or to set their state between steps; a caller that adds, removes or
+  /// reorders particles, or changes those of a rigid material at rest, calls particlesChanged().
   Particles<Dim>& particles() { return particles_; }
   const Particles<Dim>& particles() const { return particles_; }
+  /// Forgets what the solver keeps of the particles between steps (the list of those a step
+  /// changes, the sums of the rigid bodies at rest, the particle bins); the next relocateParticles
+  /// looks at every particle.
+  void particlesChanged();
   const Layout<Dim>& layout() const { return *layout_; }
   /// Host copies of the rank's particles for output.
   ParticleOutput output() const;
@@ -277,11 +283,25 @@ class MpmSolver {
   void applyNodeMomentumChange(Field<Dim>& target, bool commit);
   template <class Kernel>
   void predictCellVolumesWith(const Field<Dim>& change, double dt, Field<Dim>& volumes);
-  /// f(p) for every particle, for kernels that add into node arrays: in index order on one thread;
-  /// on more, tile colour by tile colour (bins_, rebuilt when stale), so no two threads add into
-  /// the same node.
+  /// Which particles a loop visits: every one, or those a step can change: all but the particles
+  /// of rigid materials at rest, whose position, velocity, stress and velocity change stay as
+  /// seeded (a slide's bed holds 91 % of its particles at 5 mm).
+  enum class ParticleSet { All, Changing };
+  /// f(p) for every particle of the set, in ascending index order (a parallel_for).
   template <class F>
-  void forEachParticleScattering(const char* label, const BoxLookup& lookup, const F& f);
+  void forEachParticle(const char* label, ParticleSet set, const F& f) const;
+  /// The reduction of f(p, value) over the particles of the set (a parallel_reduce).
+  template <class F, class Reducer>
+  void reduceOverParticles(const char* label, ParticleSet set, const F& f, const Reducer& reducer) const;
+  /// f(p) for every particle of the set, for kernels that add into node arrays: in index order on
+  /// one thread; on more, tile colour by tile colour (bins_, rebuilt when stale), so no two threads
+  /// add into the same node.
+  template <class F>
+  void forEachParticleScattering(const char* label, const BoxLookup& lookup, ParticleSet set, const F& f);
+  /// The indices of the set's particles, ascending, and their number; the set Changing is listed
+  /// in changing_ (rebuilt when stale) when some material is at rest, else it is every particle.
+  bool everyParticleChanges() const { return !any_stationary_; }
+  void refreshChangingList() const;
   /// The scatter `f` of every particle into `sums` (zeroed first), the particles of rigid
   /// materials at rest summed once into `stationary` and copied in (MpmOptions::stationary_sums_once).
   template <class F>
@@ -313,6 +333,16 @@ class MpmSolver {
   StationarySums stationary_nodes_, stationary_cells_;
   ParticleBins<Dim> bins_;
   bool bins_current_ = false;
+  ParticleSet bins_set_ = ParticleSet::All;  // the set the bins hold
+  // The particles a step changes (ParticleSet::Changing), ascending; stale after particles moved
+  // between ranks or were replaced.
+  bool any_stationary_ = false;  // some material is rigid and at rest
+  mutable Kokkos::View<int*, MemorySpace> changing_;  // a cache: rebuilt by const methods too
+  mutable int changing_count_ = 0;
+  mutable bool changing_current_ = false;
+  // Every particle of a rigid material at rest is on the rank that owns its cell: relocateParticles
+  // then looks at the changing particles alone. False after a new division or restored particles.
+  bool stationary_placed_ = false;
 };
 
 extern template class MpmSolver<2>;

@@ -18,6 +18,9 @@
 //
 //   bins.build(particles, grid, lookup, chunks);  // host call; three passes over the particles
 //   bins.forEachParticle(f);                      // f(p) for every particle, colour by colour
+//
+// A build may take a subset of the particles instead (their indices, ascending): forEachParticle
+// then visits those alone.
 #include "common/types.hpp"
 #include "grid/geometry.hpp"
 #include "grid/layout.hpp"
@@ -38,8 +41,10 @@ class ParticleBins {
   static_assert(kTileCells >= 4, "tiles of one colour must not share nodes");
 
   /// Sorts the particles into tiles of the node box of `lookup`, with `chunks` parallel pieces of
-  /// the particle range for the counting sort (the result does not depend on it).
-  void build(const Particles<Dim>& particles, const Grid<Dim>& grid, const BoxLookup& lookup, int chunks)
+  /// the particle range for the counting sort (the result does not depend on it). With
+  /// `subset_count` >= 0 only the particles subset(0 .. subset_count - 1) (ascending) are sorted.
+  void build(const Particles<Dim>& particles, const Grid<Dim>& grid, const BoxLookup& lookup, int chunks,
+             const Kokkos::View<int*, MemorySpace>& subset = {}, int subset_count = -1)
   {
     chunks = std::max(1, chunks);
     tile_count_ = 1;
@@ -47,7 +52,8 @@ class ParticleBins {
       tiles_[d] = int((lookup.extent[d] + kTileCells - 1) / kTileCells);
       tile_count_ *= tiles_[d];
     }
-    const int n = particles.count;
+    const bool every = subset_count < 0;
+    const int n = every ? particles.count : subset_count;
     if (int(tile_.extent(0)) < n) {
       tile_ = Kokkos::View<int*, MemorySpace>(Kokkos::view_alloc(Kokkos::WithoutInitializing, "particle tile"),
                                               std::size_t(n) * 3 / 2 + 16);
@@ -82,7 +88,8 @@ class ParticleBins {
         "mpm::bins_count", Kokkos::RangePolicy<ExecutionSpace>(0, chunks), KOKKOS_LAMBDA(const int c) {
           for (int t = 0; t < tile_count; ++t) counts(c, t) = 0;
           const int end = math::min(n, (c + 1) * per_chunk);
-          for (int p = c * per_chunk; p < end; ++p) {
+          for (int i = c * per_chunk; i < end; ++i) {
+            const int p = every ? i : subset(i);
             int t = 0;
             for (int d = Dim - 1; d >= 0; --d) {
               const double cell = math::floor((x(p, d) - origin[d]) * inv_h[d]);
@@ -90,7 +97,7 @@ class ParticleBins {
               k = k < 0 ? 0 : k / kTileCells;
               t = t * tiles[d] + int(k < tiles[d] ? k : tiles[d] - 1);
             }
-            tile(p) = t;
+            tile(i) = t;
             ++counts(c, t);
           }
         });
@@ -112,7 +119,7 @@ class ParticleBins {
     Kokkos::parallel_for(
         "mpm::bins_place", Kokkos::RangePolicy<ExecutionSpace>(0, chunks), KOKKOS_LAMBDA(const int c) {
           const int end = math::min(n, (c + 1) * per_chunk);
-          for (int p = c * per_chunk; p < end; ++p) order(counts(c, tile(p))++) = p;
+          for (int i = c * per_chunk; i < end; ++i) order(counts(c, tile(i))++) = every ? i : subset(i);
         });
   }
 
@@ -151,7 +158,7 @@ class ParticleBins {
  private:
   int tiles_[Dim] = {};
   int tile_count_ = 0;
-  Kokkos::View<int*, MemorySpace> tile_;    // tile of each particle
+  Kokkos::View<int*, MemorySpace> tile_;    // tile of each particle (of the subset)
   Kokkos::View<int*, MemorySpace> order_;   // particle indices, tile by tile, ascending in a tile
   Kokkos::View<int*, MemorySpace> start_;   // where each tile's list starts in order_ (+ the end)
   Kokkos::View<int**, Kokkos::LayoutRight, MemorySpace> counts_;  // per chunk and tile

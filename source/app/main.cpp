@@ -189,6 +189,12 @@ int main(int argc, char** argv)
       std::cout << "cfdmpm: output in " << summary.output_directory << "\n"
                 << "  fields (open in ParaView): " << summary.time_series << "\n"
                 << "  diagnostics: " << summary.diagnostics << "\n";
+      // Undone steps cost their attempts: many of them say the time step's limits miss something
+      // in the scene (the log's "undone" lines name the cell, material and quantity of each).
+      if (summary.retried_steps > 0)
+        std::cout << "  retried steps: " << summary.retried_steps << " (" << summary.undone_attempts
+                  << " attempts undone) in this run to step " << summary.steps
+                  << "; the CSV's column retries and the log's 'undone' lines say which and why\n";
     }
     // A run stopped by SIGINT or SIGTERM before its end time did not finish: exit 3 on every rank
     // (stopped_by_signal is the same on all of them).

@@ -505,7 +505,11 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
                   << scene.time.step_retries << " with dt = " << showNumber(retry_dt) << " s\n";
       dt = retry_dt;
     }
-    if (retries > 0) limit.limiter += "+retry";
+    if (retries > 0) {
+      limit.limiter += "+retry";
+      ++summary.retried_steps;
+      summary.undone_attempts += retries;
+    }
     t = (t + dt > next_output - eps) ? next_output : t + dt;
     const bool output_time = t >= next_output - eps;
     ++step;

@@ -24,6 +24,8 @@ struct RunSummary {
   std::string diagnostics;   // the CSV time series
   long long steps = 0;
   double time = 0;           // simulated time reached (s)
+  long long retried_steps = 0;    // steps of this run taken only after undone attempts
+  long long undone_attempts = 0;  // the attempts undone (a step may be retried several times)
   bool stopped_by_signal = false;
 };
 

@@ -39,9 +39,15 @@ if [ "$mode" = fail ]; then
   grep -q "step 1 undone: ice: advection: the outflux of water from cell (" "$work/retried.log" ||
     fail "retried run: the terminal does not name the undone first step and its cause"
   grep -q "retry 1 of 3 with dt = 0.01 s" "$work/retried.log" || fail "retried run: no 'retry 1 of 3 with dt = 0.01 s'"
-  "$PYTHON" - "$work/retried/retried.csv" <<'PY' || fail "retried run: the CSV's retries column"
-import csv, sys
+  "$PYTHON" - "$work/retried/retried.csv" "$work/retried.log" <<'PY' || fail "retried run: the CSV's retries column or the log's count"
+import csv, re, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
+# The run's last lines count the retried steps and the undone attempts, as the CSV does.
+summary = re.search(r"retried steps: (\d+) \((\d+) attempts undone\) in this run to step (\d+)", open(sys.argv[2]).read())
+counts = (sum(int(r["retries"]) > 0 for r in rows), sum(int(r["retries"]) for r in rows), int(rows[-1]["step"]))
+print(f"log's summary {summary.groups() if summary else None}, CSV's counts {counts}")
+if not summary or tuple(int(g) for g in summary.groups()) != counts:
+    sys.exit(1)
 retried = [r for r in rows if int(r["retries"]) > 0]
 print(f"retried run: {len(rows) - 1} steps, {len(retried)} retried "
       f"(steps {', '.join(r['step'] for r in retried)}), end t = {rows[-1]['time']} s")

@@ -111,6 +111,18 @@ std::vector<Record> gatherSorted(const std::vector<Record>& local)
 constexpr double kDt = 2.5e-4;   // fixed, so both runs take the same steps (stable dt is 3.7e-4)
 constexpr int kSteps = 600;      // 0.15 s: each block moves 0.3 m, 12 cells, across 2-3 patches
 
+/// The scene's spinning blocks run kSteps on this rank alone (MPI_COMM_SELF), sorted by id.
+std::vector<Record> oneRankRun(const Scene& scene)
+{
+  const auto self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
+  MpmSolver<2> serial(scene, scenes::layoutFor<2>(scene, self), MpmOptions{});
+  addSpin(serial);
+  for (int n = 0; n < kSteps; ++n) serial.step(kDt);
+  std::vector<Record> reference = records(serial);
+  std::sort(reference.begin(), reference.end(), [](const Record& a, const Record& b) { return a.id < b.id; });
+  return reference;
+}
+
 /// The crossing scene with a rigid plate at rest along its top, across every rank's patches: two
 /// cells thick, 2 cells (50 mm) above the highest corner the spinning gel block reaches (~0.63 m).
 Scene crossingSceneWithPlate()
@@ -170,12 +182,7 @@ TEST(ParticleMigration, BlocksCrossingRankBordersKeepEveryParticleAndMatchOneRan
 
   // The same scene on one rank, on rank 0 only.
   if (world()->getRank() == 0) {
-    const auto self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
-    MpmSolver<2> serial(scene, scenes::layoutFor<2>(scene, self), MpmOptions{});
-    addSpin(serial);
-    for (int n = 0; n < kSteps; ++n) serial.step(kDt);
-    std::vector<Record> reference = records(serial);
-    std::sort(reference.begin(), reference.end(), [](const Record& a, const Record& b) { return a.id < b.id; });
+    const std::vector<Record> reference = oneRankRun(scene);
 
     std::printf("[ migrate  ] %d rank(s): %lld particles, %lld migrations over %d steps\n", world()->getSize(), count,
                 sent_total, kSteps);
@@ -304,12 +311,7 @@ TEST(ParticleMigration, PlateAtRestIsSkippedStaysAsSeededAndFollowsANewDecomposi
   const std::vector<Record> parallel = gatherSorted(records(solver));
 
   if (world()->getRank() == 0) {
-    const auto self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
-    MpmSolver<2> serial(scene, scenes::layoutFor<2>(scene, self), MpmOptions{});
-    addSpin(serial);
-    for (int n = 0; n < kSteps; ++n) serial.step(kDt);
-    std::vector<Record> reference = records(serial);
-    std::sort(reference.begin(), reference.end(), [](const Record& a, const Record& b) { return a.id < b.id; });
+    const std::vector<Record> reference = oneRankRun(scene);
     ASSERT_EQ(parallel.size(), initial.size());
     ASSERT_EQ(reference.size(), initial.size());
     int plate = 0;

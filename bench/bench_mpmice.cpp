@@ -1,7 +1,8 @@
 // Benchmark of the coupled step on the seed scene (input/rzadkiewicz.yaml, 10 mm cells): microseconds
 // per cell and step of the whole coupled step and per phase (Teuchos timers "mpmice: <phase>"), next
 // to the fluid step alone on the same grid in the same run (the scene without its solids: water and
-// air), and their ratio. Both run the same number of steps at the same fixed Δt, after a warm-up.
+// air), and their ratio. Both run the same number of steps at the same fixed Δt, after a warm-up,
+// in alternating blocks of steps (the ratio of each block shows the host's noise).
 //
 // usage: [mpiexec -n N] bench_mpmice [steps [dt]]     (defaults 200 steps of 2e-5 s)
 #include "coupled_support.hpp"
@@ -9,12 +10,16 @@
 
 #include <Tpetra_Core.hpp>
 
+#include <algorithm>
 #include <iomanip>
 #include <iostream>
 
 using namespace cfdmpm;
 
 namespace {
+
+// Steps per block: the runs alternate every kBlockSteps steps (~0.1-0.3 s of each on one core).
+constexpr int kBlockSteps = 10;
 
 /// The scene without its solid materials and their regions: the fluids alone on the same grid.
 Scene fluidsOnly(const Scene& scene)
@@ -40,44 +45,73 @@ std::vector<std::string> phases()
   return all;
 }
 
-/// Runs `steps` steps of dt after 5 warm-up steps; returns the slowest rank's seconds per phase.
-/// Also the outer and linear (CG) pressure iterations per step, and the ICE pressure phase [5] alone
-/// (outer iterations, matrix, solves) as the phase "5 pressure" (inside "3-6 fluid pressure").
-std::map<std::string, double> measure(const Scene& scene, int steps, double dt, double& outer_per_step,
-                                      double& linear_per_step, const Teuchos::RCP<const Teuchos::Comm<int>>& comm)
-{
-  // The division the program takes: by cells, or with the cells that rigid bodies fill weighed
-  // less (divisionByOpenCells), from the initial state.
-  const Grid<2> grid(scene.domain);
-  const Decomposition division =
-      divisionByOpenCells(buildRunState(scene, grid, partitionPatches(grid, comm->getSize()), comm), 0.0)
-          .decomposition;
-  test::CoupledRun<2> run(scene, comm, division);
-  const auto advance = [&] {
-    run.last = run.stepper.step(run.state, dt);
-    run.time += dt;
-  };
-  for (int s = 0; s < 5; ++s) advance();
-  std::map<std::string, double> before, spent;
-  const auto seconds = [&](const std::string& phase) {
-    return phase == "5 pressure" ? run.stepper.fluids()->phaseSeconds("pressure") : run.stepper.phaseSeconds(phase);
-  };
-  for (const std::string& phase : phases()) before[phase] = seconds(phase);
-  long long outer = 0, linear = 0;
-  for (int s = 0; s < steps; ++s) {
-    advance();
-    outer += run.last.ice.outer_iterations;
-    linear += run.last.ice.linear_iterations;
+/// One of the two runs the benchmark times: its phases' seconds on this rank and its pressure
+/// iterations, summed over the blocks of steps it took.
+class TimedRun {
+ public:
+  /// The division the program takes: by cells, or with the cells that rigid bodies fill weighed
+  /// less (divisionByOpenCells), from the initial state; then 5 warm-up steps of dt.
+  TimedRun(const Scene& scene, double dt, const Teuchos::RCP<const Teuchos::Comm<int>>& comm)
+      : run_(scene, comm, division(scene, comm)), dt_(dt)
+  {
+    for (int s = 0; s < 5; ++s) advance();
+    for (const std::string& phase : phases()) spent_[phase] = 0.0;
   }
-  outer_per_step = double(outer) / steps;
-  linear_per_step = double(linear) / steps;
-  for (const std::string& phase : phases()) {
-    double local = seconds(phase) - before[phase], slowest = 0;
-    Teuchos::reduceAll(*comm, Teuchos::REDUCE_MAX, local, Teuchos::outArg(slowest));
-    spent[phase] = slowest;
+
+  /// `steps` more steps; returns this rank's seconds of the whole step over them.
+  double block(int steps)
+  {
+    std::map<std::string, double> before;
+    for (const std::string& phase : phases()) before[phase] = seconds(phase);
+    for (int s = 0; s < steps; ++s) {
+      advance();
+      outer_ += run_.last.ice.outer_iterations;
+      linear_ += run_.last.ice.linear_iterations;
+    }
+    for (const std::string& phase : phases()) spent_[phase] += seconds(phase) - before[phase];
+    steps_ += steps;
+    return seconds("step") - before["step"];
   }
-  return spent;
-}
+
+  /// The slowest rank's seconds per phase over every block (collective).
+  std::map<std::string, double> slowest(const Teuchos::Comm<int>& comm) const
+  {
+    std::map<std::string, double> result;
+    for (const auto& [phase, local] : spent_) {
+      double value = 0;
+      Teuchos::reduceAll(comm, Teuchos::REDUCE_MAX, local, Teuchos::outArg(value));
+      result[phase] = value;
+    }
+    return result;
+  }
+  double outerPerStep() const { return double(outer_) / steps_; }
+  double linearPerStep() const { return double(linear_) / steps_; }
+
+ private:
+  static Decomposition division(const Scene& scene, const Teuchos::RCP<const Teuchos::Comm<int>>& comm)
+  {
+    const Grid<2> grid(scene.domain);
+    return divisionByOpenCells(buildRunState(scene, grid, partitionPatches(grid, comm->getSize()), comm), 0.0)
+        .decomposition;
+  }
+  void advance()
+  {
+    run_.last = run_.stepper.step(run_.state, dt_);
+    run_.time += dt_;
+  }
+  /// The ICE pressure phase [5] alone (outer iterations, matrix, solves) is "5 pressure", inside
+  /// "3-6 fluid pressure".
+  double seconds(const std::string& phase)
+  {
+    return phase == "5 pressure" ? run_.stepper.fluids()->phaseSeconds("pressure") : run_.stepper.phaseSeconds(phase);
+  }
+
+  test::CoupledRun<2> run_;
+  double dt_;
+  std::map<std::string, double> spent_;
+  long long outer_ = 0, linear_ = 0;
+  int steps_ = 0;
+};
 
 }  // namespace
 
@@ -91,9 +125,22 @@ int main(int argc, char** argv)
     const double dt = argc > 2 ? std::atof(argv[2]) : 2e-5;
     const Scene scene = readScene(std::string(CFDMPM_SOURCE_DIR) + "/input/rzadkiewicz.yaml");
     const double cells = double(scene.domain.cells[0] * scene.domain.cells[1]);
-    double outer_coupled = 0, outer_fluid = 0, linear_coupled = 0, linear_fluid = 0;
-    const auto coupled = measure(scene, steps, dt, outer_coupled, linear_coupled, comm);
-    const auto fluid = measure(fluidsOnly(scene), steps, dt, outer_fluid, linear_fluid, comm);
+    // The two runs take their steps in alternating blocks, so that a change of the shared host's
+    // speed during the run weighs on both alike; each block's ratio shows how much it moved.
+    TimedRun coupled_run(scene, dt, comm), fluid_run(fluidsOnly(scene), dt, comm);
+    std::vector<double> block_ratios;
+    for (int done = 0; done < steps; done += kBlockSteps) {
+      const int block = std::min(kBlockSteps, steps - done);
+      const double local[2] = {coupled_run.block(block), fluid_run.block(block)};
+      double slowest[2] = {0, 0};
+      Teuchos::reduceAll(*comm, Teuchos::REDUCE_MAX, 2, local, slowest);
+      block_ratios.push_back(slowest[0] / slowest[1]);
+    }
+    std::sort(block_ratios.begin(), block_ratios.end());
+    const auto coupled = coupled_run.slowest(*comm);
+    const auto fluid = fluid_run.slowest(*comm);
+    const double outer_coupled = coupled_run.outerPerStep(), outer_fluid = fluid_run.outerPerStep();
+    const double linear_coupled = coupled_run.linearPerStep(), linear_fluid = fluid_run.linearPerStep();
     if (root) {
       std::cout << "Rzadkiewicz slide, " << scene.domain.cells[0] << " x " << scene.domain.cells[1] << " cells, "
                 << comm->getSize() << " rank(s), " << steps << " steps of " << dt << " s\n"
@@ -108,7 +155,9 @@ int main(int argc, char** argv)
         std::cout << std::left << std::setw(26) << phase << std::right << std::setw(16)
                   << 1e6 * coupled.at(phase) / (cells * steps) << std::setw(16) << 1e6 * fluid.at(phase) / (cells * steps)
                   << "\n";
-      std::cout << "coupled / fluids alone (whole step): " << coupled.at("step") / fluid.at("step") << "\n";
+      std::cout << "coupled / fluids alone (whole step): " << coupled.at("step") / fluid.at("step") << "\n"
+                << "  per block of " << kBlockSteps << " steps (the runs alternating): lowest " << block_ratios.front()
+                << ", median " << block_ratios[block_ratios.size() / 2] << ", highest " << block_ratios.back() << "\n";
     }
   }
   return 0;

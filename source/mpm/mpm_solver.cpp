@@ -420,9 +420,7 @@ void MpmSolver<Dim>::scatterWithStationarySums(const char* label, const BoxLooku
                                                StationarySums& stationary, const F& f)
 {
   const MaterialTable table = materialTable(materials_);
-  bool any = false;
-  for (int m = 0; m < table.count; ++m) any = any || table.stationary(m);
-  if (!options_.stationary_sums_once || !any) {
+  if (!options_.stationary_sums_once || everyParticleChanges()) {
     sums.fill(0.0);
     forEachParticleScattering(label, lookup, ParticleSet::All, f);
     return;

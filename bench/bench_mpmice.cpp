@@ -123,6 +123,10 @@ int main(int argc, char** argv)
     const bool root = comm->getRank() == 0;
     const int steps = argc > 1 ? std::atoi(argv[1]) : 200;
     const double dt = argc > 2 ? std::atof(argv[2]) : 2e-5;
+    if (steps < 1 || !(dt > 0)) {
+      if (root) std::cerr << "usage: bench_mpmice [steps [dt]]: steps >= 1 and dt > 0 s (got " << steps << ", " << dt << ")\n";
+      return 2;
+    }
     const Scene scene = readScene(std::string(CFDMPM_SOURCE_DIR) + "/input/rzadkiewicz.yaml");
     const double cells = double(scene.domain.cells[0] * scene.domain.cells[1]);
     // The two runs take their steps in alternating blocks, so that a change of the shared host's

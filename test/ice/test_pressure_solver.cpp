@@ -686,6 +686,36 @@ TEST(PressureSolverBehaviour, ResidualTargetBoundsTheLargestEntry)
   EXPECT_LT(by_entry.iterations, by_norm.iterations);
 }
 
+// An iterate that turns NaN (a right-hand side of 1e300 in one cell, whose square overflows CG's
+// first step length to inf / inf, and every value after it) is reported as not converged at once,
+// with the reason, whatever the measure: the largest entry (an absolute target, as the ICE step
+// solves) and the 2-norm. Tpetra's own largest-entry norm passes over a NaN and gave a negative
+// value for a vector of NaN, which passed the test "at most the target" with every value of the
+// solution NaN.
+TEST(PressureSolverBehaviour, AnIterateThatTurnsNaNIsNotConverged)
+{
+  const Grid<2> grid({0, 0, 0}, {1.28, 0.64, 0}, {128, 64, 1}, {16, 16, 1});
+  for (const double target : {1e-6, 0.0}) {
+    Problem<2> p(makeLayout(grid));
+    waterColumn(p, {0.325, 0.475, 0}, 1e-4);
+    auto rhs = p.rhs.view();
+    if (p.layout->ownedCells() > 0 && p.layout->comm()->getRank() == 0) rhs(0, 0) = 1e300;
+    PressureSolver<2> solver(p.layout, settings("none", 1e-10, 50));
+    solver.assemble(p.kappa, p.beta, p.dt);
+    p.solution.fill(0.0);
+    const PressureSolveReport report = solver.solve(p.rhs, p.solution, target * 1e300);
+    printLine("target " + std::to_string(target) + ": " + std::to_string(report.iterations) + " CG iterations, relative residual " +
+              std::to_string(report.relative_residual) + ", failure '" + report.failure + "'");
+    EXPECT_FALSE(report.converged);
+    EXPECT_FALSE(report.relative_residual <= report.tolerance);
+    if (target > 0) {
+      // Stopped at the first check that saw it, not at the budget of 50.
+      EXPECT_LE(report.iterations, 2);
+      EXPECT_NE(report.failure.find("not finite"), std::string::npos) << report.failure;
+    }
+  }
+}
+
 // An iteration budget that is too small is reported, not hidden.
 TEST(PressureSolverBehaviour, UnconvergedSolveIsReported)
 {

@@ -264,7 +264,8 @@ AdvectionStatus Advector<Dim>::outfluxStatus(const LargestOutflow& local) const
 
 template <int Dim>
 AdvectionStatus Advector<Dim>::advect(FaceField<Dim>& face_velocity, double dt, Field<Dim>& mass,
-                                      const std::vector<Field<Dim>*>& mass_specific, const CapView& outflow_share)
+                                      const std::vector<Field<Dim>*>& mass_specific, const CapView& outflow_share,
+                                      const FractionView& volume_fraction)
 {
   if (mass.columns() != materials_)
     throw std::invalid_argument("Advector: mass has " + std::to_string(mass.columns()) + " columns, expected " +
@@ -286,7 +287,7 @@ AdvectionStatus Advector<Dim>::advect(FaceField<Dim>& face_velocity, double dt, 
   // 2. Mass leaving each cell through each face, from the limited density profile of the donor,
   //    and the slab values of every mass-specific column, in one pass that also checks the outflow.
   const AdvectionStatus status =
-      outfluxStatus(reconstruct(face_velocity, dt, mass, mass_specific, false, outflow_share));
+      outfluxStatus(reconstruct(face_velocity, dt, mass, mass_specific, false, outflow_share, CellMask(), volume_fraction));
   if (!status.ok) return status;
 
   // 3. New mass and compatible update of every column, then the outputs' ghosts.
@@ -339,9 +340,12 @@ const typename Advector<Dim>::WorkView& Advector<Dim>::slabDensities(const FaceF
 template <int Dim>
 LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass,
                                           const std::vector<Field<Dim>*>& mass_specific, bool slab_densities,
-                                          const CapView& outflow_share, const CellMask& skip)
+                                          const CapView& outflow_share, const CellMask& skip,
+                                          const FractionView& volume_fraction)
 {
   const bool capped = outflow_share.extent(0) > 0;
+  // Traces leave whole (advect): only where the slabs are capped, which keeps their mass >= 0.
+  const bool traces = capped && volume_fraction.extent(0) > 0;
   const Slabs<Dim> slabs(face_velocity, *layout_, dt, options_.transverse_correction);
   const CellStencil<Dim> stencil(*layout_, block_);
   const auto M = mass.view();
@@ -363,6 +367,7 @@ LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, d
   const auto closed = options_.closed_cells;
   const bool any_closed = closed.extent(0) > 0;
   const bool skipping = skip.extent(0) > 0;
+  constexpr double kTrace = kTraceFraction;
 
   // Per cell (owned and ghost, so that every owned face has its donor) and material, the slab
   // geometry from the cell's 2 Dim face velocities, then:
@@ -374,7 +379,8 @@ LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, d
   //   within its block bounds in the slabs and in the mass left behind, so the new q is a
   //   mass-weighted mean of values within bounds (compatible fluxes).
   // Both read the old mass and the cell's own slabs only. Owned cells also enter the largest
-  // outflow fraction Σ_f V_out / V_cell of every material, with or without mass.
+  // outflow fraction Σ_f V_out / V_cell of every material, with or without mass, but for a trace
+  // (below kTraceFraction of the cell, where volume fractions are given).
   LargestOutflow largest;
   Kokkos::parallel_reduce(
       "advection slabs", Kokkos::RangePolicy<ExecutionSpace>(0, cells),
@@ -394,7 +400,8 @@ LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, d
           // A held material: update() skips it and its slab densities keep their initial 0.
           if (held >> m & 1u) continue;
           if (!(M(c, m) > 0.0)) {
-            if (c < owned) best.include(slabs.totalOutflowFraction(c, m, local.neighbour), stencil.globalId(c) * materials + m);
+            if (c < owned && !(traces && volume_fraction(c, m) < kTrace))
+              best.include(slabs.totalOutflowFraction(c, m, local.neighbour), stencil.globalId(c) * materials + m);
             // No mass of m here: nothing leaves (the block's lower bound is 0 and the limiter sets
             // the slope to 0: every slab would carry exactly 0). The slab values then weigh
             // nothing; only the block bounds of q are needed, to bound q where mass flows in,
@@ -424,7 +431,7 @@ LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, d
           }
           double fraction[2 * Dim], r[2 * Dim][Dim];
           slabs.cellSlabs(c, m, local.neighbour, fraction, r);
-          if (c < owned) {
+          if (c < owned && !(traces && volume_fraction(c, m) < kTrace)) {
             double total = 0;
             for (int f = 0; f < 2 * Dim; ++f) total += fraction[f];
             best.include(total, stencil.globalId(c) * materials + m);
@@ -445,7 +452,13 @@ LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, d
           double lo, hi;
           stencil.blockBounds(M, c, local, m, lo, hi);
           const double value = M(c, m);
-          const double phi = limiter(value, lo, hi, spread, remaining > 0 ? remaining : 0.0, S);
+          // Slabs that together sweep more than the cell (a trace that leaves whole, advect()) take
+          // the cell's mean, not its linear profile: evaluated beyond the cell the profile of a
+          // trace next to more of it went below zero on one face and sent negative mass (a water
+          // trace of a slide in air at 10 mm left -1.3e-5 kg/m^3 in its receiver and +1.3e-5 in
+          // itself, which the face's density-weighted mean then divided by zero).
+          const bool whole = remaining < 0;
+          const double phi = whole ? 0.0 : limiter(value, lo, hi, spread, remaining > 0 ? remaining : 0.0, S);
           double slab_mass[2 * Dim];
           double left = value;  // the mass that stays in the cell
           double leaving = 0;
@@ -483,7 +496,7 @@ LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, d
               double lo_q, hi_q;
               stencil.blockBounds(Q, c, local, col, lo_q, hi_q);
               const double value_q = Q(c, col);
-              const double phi_q = limiter(value_q, lo_q, hi_q, spread_q, left, S_q);
+              const double phi_q = whole ? 0.0 : limiter(value_q, lo_q, hi_q, spread_q, left, S_q);
               for (int f = 0; f < 2 * Dim; ++f) outflow_value(c, f, slot) = value_q + phi_q * slope_q[f];
               bounds(c, slot, 0) = lo_q;
               bounds(c, slot, 1) = hi_q;

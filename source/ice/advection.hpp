@@ -39,7 +39,8 @@ struct LargestOutflow {
 /// out more than its volume in one step (Uintah's "bulletproofing"): the caller reduces Δt.
 struct AdvectionStatus {
   bool ok = true;
-  /// Largest Σ_faces V_out / V_cell over all cells and materials (the outflow Courant number).
+  /// Largest Σ_faces V_out / V_cell over all cells and materials (the outflow Courant number), but
+  /// for the traces that advect() lets leave whole (its volume_fraction).
   double max_outflux_fraction = 0.0;
   long long cell = -1;  // global id of the cell where the maximum occurs (lowest id on ties)
   int material = -1;    // and its material
@@ -90,9 +91,20 @@ class Advector {
   ///   (IceSolver::fluidFaceFractions); above 1 next to a solid, whose edge the profile cannot hold.
   ///   A cell never gives more than its mass: if the slabs ask for more, all of it leaves, in
   ///   proportion.
+  /// - volume_fraction (optional, with outflow_share; owned cells): each material's volume fraction.
+  ///   A material that holds less than kTraceFraction of a cell may leave it whole in one step: its
+  ///   outflow does not refuse the step (nor enter max_outflux_fraction). Beside a solid such a
+  ///   trace sits in the gaps of the particles' coverage, and its face velocity, which the
+  ///   pressure correction sets for the face and not for it, may sweep several cells in a step
+  ///   while all it holds is less than a thousandth of its cell.
   using CapView = Kokkos::View<double**, MemorySpace>;
+  using FractionView = typename Field<Dim>::ConstView;
   AdvectionStatus advect(FaceField<Dim>& face_velocity, double dt, Field<Dim>& mass,
-                         const std::vector<Field<Dim>*>& mass_specific, const CapView& outflow_share = CapView());
+                         const std::vector<Field<Dim>*>& mass_specific, const CapView& outflow_share = CapView(),
+                         const FractionView& volume_fraction = FractionView());
+
+  /// A material below this volume fraction of a cell is a trace there (advect's volume_fraction).
+  static constexpr double kTraceFraction = 1e-3;
 
   /// The limited mass profile of every cell (owned and ghost) evaluated in the outflow slab of each
   /// of its faces for these face velocities, i.e. the bulk density that advect() would move through
@@ -117,7 +129,8 @@ class Advector {
   /// The slab pass; returns this rank's largest outflow fraction and where it occurs.
   LargestOutflow reconstruct(const FaceField<Dim>& face_velocity, double dt, const Field<Dim>& mass,
                              const std::vector<Field<Dim>*>& mass_specific, bool slab_densities = false,
-                             const CapView& outflow_share = CapView(), const CellMask& skip = CellMask());
+                             const CapView& outflow_share = CapView(), const CellMask& skip = CellMask(),
+                             const FractionView& volume_fraction = FractionView());
   AdvectionStatus outfluxStatus(const LargestOutflow& local) const;
   void update(Field<Dim>& mass, const std::vector<Field<Dim>*>& mass_specific);
 

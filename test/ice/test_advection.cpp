@@ -576,6 +576,89 @@ TYPED_TEST(AdvectionTest, NegativeMassSendsNothingWhereTheRoomBesideASolidIsFill
   EXPECT_EQ(ownedSum(s.mass, 1, [](LocalOrdinal) { return 1.0; }), total0);
 }
 
+// With solids in the cells (the slabs capped by outflow_share, the volume fractions given), a
+// material that holds less than Advector::kTraceFraction of a cell leaves it whole when its face
+// velocities sweep more than the cell: the step goes on, the trace is gone from its cell, the mass
+// is conserved. The same flow of a material above the trace is refused, and so is the trace where
+// the slabs are not capped (fluids alone: an uncapped slab would send more than the mass).
+TYPED_TEST(AdvectionTest, ATraceBesideASolidLeavesWholeWhereMoreIsRefused)
+{
+  constexpr int Dim = TypeParam::value;
+  const Grid<Dim> grid = unitGrid<Dim>(Dim == 2 ? 24 : 10, 4);
+  const auto layout = makeLayout(grid);
+  const double dx = grid.spacing()[0], dt = 0.01, V = grid.cellVolume();
+  const std::array<long long, 3> culprit{5, 7, Dim == 3 ? 3 : 0};
+  const long long culprit_id = grid.cellId(culprit);
+  const auto at_culprit = [&](LocalOrdinal c) {
+    for (int d = 0; d < Dim; ++d)
+      if (layout->cellIndex()(c, d) != culprit[d]) return false;
+    return true;
+  };
+  // Material 1 leaves the culprit through both x faces, 3.5 + 4.5 of its volume (a face velocity
+  // that the pressure correction set for the face) and is still elsewhere; material 0 moves 0.1 of
+  // a cell per face.
+  const auto faces = [&](int d, int m, const Point& x) {
+    if (m == 0) return 0.1 * dx / dt;
+    bool row = d == 0;
+    for (int e = 1; e < Dim; ++e) row = row && std::lround(x[e] / dx - 0.5) == culprit[e];
+    const long long face = std::lround(x[0] / dx);
+    if (row && face == culprit[0]) return -3.5 * dx / dt;
+    if (row && face == culprit[0] + 1) return 4.5 * dx / dt;
+    return 0.0;
+  };
+  const auto run = [&](double fraction, bool capped) {
+    MixedCase<Dim> s(layout);
+    setFaces(s.face_velocity, faces);
+    Field<Dim> theta(layout, Location::Cell, s.materials, "volume_fraction");
+    auto mass = s.mass.view();
+    auto t = theta.view();
+    for (LocalOrdinal c = 0; c < layout->overlapCells(); ++c) {
+      if (at_culprit(c)) mass(c, 1) = fraction * V;
+      for (int m = 0; m < s.materials; ++m) t(c, m) = mass(c, m) / V;
+    }
+    typename Advector<Dim>::CapView share;
+    if (capped) {
+      share = typename Advector<Dim>::CapView("share", layout->overlapCells(), 2 * Dim);
+      Kokkos::deep_copy(share, 1.0);
+    }
+    const double total0 = ownedSum(s.mass, 1, [](LocalOrdinal) { return 1.0; });
+    Advector<Dim> advector(layout, s.materials);
+    const AdvectionStatus status = advector.advect(s.face_velocity, dt, s.mass, s.quantities(), share, theta.view());
+    double left = 0;
+    for (LocalOrdinal c = 0; c < layout->ownedCells(); ++c)
+      if (at_culprit(c)) left += mass(c, 1);
+    const double total = ownedSum(s.mass, 1, [](LocalOrdinal) { return 1.0; });
+    return std::make_tuple(status, globalSum(left), total0, total);
+  };
+  {
+    const auto [status, left, total0, total] = run(0.5 * Advector<Dim>::kTraceFraction, true);
+    EXPECT_TRUE(status.ok) << status.message();
+    // What material 0 sends: 0.1 of a cell through each upper face; the fractions are |u| dt / dx
+    // with a few roundings each, 1e-12 is far above that.
+    EXPECT_NEAR(status.max_outflux_fraction, 0.1 * Dim, 1e-12);
+    // All of the trace left and nothing came in (what stays is the round-off of subtracting it
+    // from itself).
+    EXPECT_LE(std::abs(left), 1e-15 * V);
+    // Conserved to round-off of sums over ~600 cells of masses <= V.
+    EXPECT_NEAR(total, total0, 1e-13 * total0);
+  }
+  {
+    const auto [status, left, total0, total] = run(2.0 * Advector<Dim>::kTraceFraction, true);
+    EXPECT_FALSE(status.ok);
+    EXPECT_EQ(status.cell, culprit_id);
+    EXPECT_EQ(status.material, 1);
+    EXPECT_NEAR(status.max_outflux_fraction, 8.0, 1e-12);
+    EXPECT_EQ(left, 2.0 * Advector<Dim>::kTraceFraction * V);  // refused: nothing moved
+    EXPECT_EQ(total, total0);
+  }
+  {
+    const auto [status, left, total0, total] = run(0.5 * Advector<Dim>::kTraceFraction, false);
+    EXPECT_FALSE(status.ok);
+    EXPECT_EQ(status.cell, culprit_id);
+    EXPECT_EQ(status.material, 1);
+  }
+}
+
 TYPED_TEST(AdvectionTest, MassSpecificValuesStayWithinTheirRangeInACompressingFlow)
 {
   // A flow that converges and diverges: densities pile up (as they should), but each q is a

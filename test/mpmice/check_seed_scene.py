@@ -4,7 +4,11 @@ sand's centre of mass lower than at the start, every value finite, and, at every
 energy of all materials no more than the potential energy that the sand's descent released (its
 buoyant weight times its drop: the energy budget allows nothing else).
 
-usage: check_seed_scene.py OUTPUT_DIRECTORY [SAND_MATERIAL_INDEX (default 1: bed, sand, water, air)]"""
+With --no-retries, also that no step was undone and retried (the CSV's retries column).
+
+usage: check_seed_scene.py OUTPUT_DIRECTORY [SAND_MATERIAL_INDEX (default 1: bed, sand, water, air)
+                           [SURROUNDING_DENSITY (default 999.8: water; the sand's weight counts less
+                           the displaced fluid's)]] [--no-retries]"""
 import csv
 import glob
 import math
@@ -13,7 +17,9 @@ import sys
 import h5py
 import numpy as np
 
-out = sys.argv[1]
+no_retries = "--no-retries" in sys.argv
+args = [a for a in sys.argv[1:] if a != "--no-retries"]
+out = args[0]
 rows = list(csv.DictReader(open(glob.glob(out + "/*.csv")[0])))
 failures = []
 
@@ -34,9 +40,12 @@ for solid in solids:
     check(first["mass_" + solid] == last["mass_" + solid], "%s particle mass unchanged (%s)" % (solid, last["mass_" + solid]))
 finite = all(math.isfinite(float(v)) for r in rows for k, v in r.items() if k != "dt_limiter")
 check(finite, "every CSV value finite")
+if no_retries:
+    retried = [r["step"] for r in rows if int(r["retries"]) > 0]
+    check(not retried, "no step undone and retried (%d were: %s)" % (len(retried), " ".join(retried[:10])))
 
 steps = sorted(glob.glob(out + "/*_[0-9]*.h5"))
-SAND = int(sys.argv[2]) if len(sys.argv) > 2 else 1  # scene material index of the sand
+SAND = int(args[1]) if len(args) > 1 else 1  # scene material index of the sand
 
 
 def sand_centre(path):
@@ -53,7 +62,8 @@ with h5py.File(steps[-1], "r") as f:
     check(all(np.isfinite(f[k][:]).all() for k in ("cells/pressure", "particles/position", "particles/velocity")),
           "pressure and particles finite at the end")
 
-rho_s, rho_w, g = 1985.0, 999.8, 9.81
+rho_s, g = 1985.0, 9.81
+rho_w = float(args[2]) if len(args) > 2 else 999.8  # the fluid the sand moves in
 sand_mass = float(last["mass_sand"])
 # At every output, not only the last: a growth that later settles (into the walls' friction or the
 # sand's plasticity) is still energy from nothing.

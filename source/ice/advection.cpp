@@ -399,8 +399,10 @@ LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, d
         for (int m = 0; m < materials; ++m) {
           // A held material: update() skips it and its slab densities keep their initial 0.
           if (held >> m & 1u) continue;
+          // Whether its outflow enters the largest outflow fraction: an owned cell, not a trace.
+          const bool counted = c < owned && !(traces && volume_fraction(c, m) < kTrace);
           if (!(M(c, m) > 0.0)) {
-            if (c < owned && !(traces && volume_fraction(c, m) < kTrace))
+            if (counted)
               best.include(slabs.totalOutflowFraction(c, m, local.neighbour), stencil.globalId(c) * materials + m);
             // No mass of m here: nothing leaves (the block's lower bound is 0 and the limiter sets
             // the slope to 0: every slab would carry exactly 0). The slab values then weigh
@@ -431,7 +433,7 @@ LargestOutflow Advector<Dim>::reconstruct(const FaceField<Dim>& face_velocity, d
           }
           double fraction[2 * Dim], r[2 * Dim][Dim];
           slabs.cellSlabs(c, m, local.neighbour, fraction, r);
-          if (c < owned && !(traces && volume_fraction(c, m) < kTrace)) {
+          if (counted) {
             double total = 0;
             for (int f = 0; f < 2 * Dim; ++f) total += fraction[f];
             best.include(total, stencil.globalId(c) * materials + m);

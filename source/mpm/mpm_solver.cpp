@@ -867,14 +867,16 @@ template <int Dim, class CellView>
 KOKKOS_INLINE_FUNCTION void addMovedBox(const double x[Dim], const double l[Dim], const double velocity[Dim], double dt,
                                         double Vp, const double origin[Dim], const double spacing[Dim],
                                         const long long count[Dim], const BoxLookup& cells, const CellView& out,
-                                        int column)
+                                        int column, int touch_column = -1)
 {
   double moved[Dim];
   for (int d = 0; d < Dim; ++d) moved[d] = x[d] + dt * velocity[d];
   const CellOverlap<Dim> predicted(moved, l, origin, spacing, count);
   for (int k = 0; k < predicted.count; ++k) {
     const LocalOrdinal c = cells(predicted.cell[k][0], predicted.cell[k][1], predicted.cell[k][2]);
-    if (c >= 0) out(c, column) += predicted.share[k] * Vp;
+    if (c < 0) continue;
+    out(c, column) += predicted.share[k] * Vp;
+    if (touch_column >= 0) out(c, touch_column) += 1.0;
   }
 }
 
@@ -1059,6 +1061,7 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt, bool fore
     origin[d] = grid.lower()[d], spacing[d] = grid.spacing()[d], count[d] = grid.cells()[d];
   const double cell_volume = grid.cellVolume();
   const double layer = options_.face_layer;
+  const int touch = touchColumn(nm);  // +1 with every contribution to a cell (touchColumn)
   const auto scatter = KOKKOS_LAMBDA(const int p)
   {
     const int m = material(p);
@@ -1075,11 +1078,12 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt, bool fore
       const LocalOrdinal c = cells(overlap.cell[k][0], overlap.cell[k][1], overlap.cell[k][2]);
       if (c < 0) continue;  // cannot happen for a particle in an owned cell (ghost_width >= 1)
       const double w = overlap.share[k];
+      out(c, touch) += 1.0;
       out(c, m) += w * mp;
       out(c, nm + m) += w * Vp;
       for (int d = 0; d < Dim; ++d) out(c, 2 * nm + m * Dim + d) += w * mp * velocity[d];
     }
-    addMovedBox<Dim>(xp, lp, velocity, dt, Vp, origin, spacing, count, cells, out, predictedVolumeColumn(nm, m));
+    addMovedBox<Dim>(xp, lp, velocity, dt, Vp, origin, spacing, count, cells, out, predictedVolumeColumn(nm, m), touch);
     // Adds scale × (below, above) to the pair of columns from `column` (a face's sides) of the cells
     // at face f of direction d, in proportion to the particle's overlap w with each of them across d.
     const auto addToFace = [&](int column, int d, long long f, double scale, double below, double above) {
@@ -1089,6 +1093,7 @@ void MpmSolver<Dim>::particlesToCellsWith(Field<Dim>& sums, double dt, bool fore
         if (c < 0) return;
         out(c, column) += w * scale * below;
         out(c, column + 1) += w * scale * above;
+        out(c, touch) += 1.0;
       });
     };
     // The cover over the step, per side: the share of the face that the box covers in the step as

@@ -128,8 +128,13 @@ class MpmSolver {
   // --- transfers of the coupled step (mpmice/): particles <-> cells ------------------------------
   /// Columns of a cell field for particlesToCells / addCellVelocityChange: per MPM material a,
   /// mass (column a), volume (materials + a) and momentum or velocity change (2 materials + a Dim + d),
-  /// then the face shares of particlesToCells (faceColumn) and the covers over the step (roomColumn).
-  static int cellColumns(int materials) { return materials * (3 + 5 * Dim); }
+  /// then the face shares of particlesToCells (faceColumn), the covers over the step (roomColumn)
+  /// and the count of particle contributions (touchColumn).
+  static int cellColumns(int materials) { return touchColumn(materials) + 1; }
+  /// Column of the number of particle contributions particlesToCells added to a cell, every column
+  /// alike: where it is 0 every other column is, so a caller can pass over the cells that no
+  /// particle reaches reading one column instead of all of them.
+  KOKKOS_INLINE_FUNCTION static int touchColumn(int materials) { return materials * (3 + 5 * Dim); }
   /// Column of material a's volume in a cell with every particle moved by Δt ṽ_p (particlesToCells).
   KOKKOS_INLINE_FUNCTION static int predictedVolumeColumn(int materials, int a) { return materials * (2 + 3 * Dim) + a; }
   /// Column of material a's share of the lower face of a cell in direction d, in the layer below the

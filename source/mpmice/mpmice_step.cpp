@@ -288,11 +288,28 @@ void MpmIceStep<Dim>::cellsFromParticles(CellState<Dim>& state, double dt)
     face_cover[d] = ice_->solidFaceCovers().direction(d).view();
   }
   // The cells where a solid is or reaches, marked as their columns are set (IceSolver::solidCellsToMark).
+  // A cell unmarked since the last call holds zeros in the solids' face shares, covers and velocities
+  // (only this function writes them); if no particle reached it now either (touchColumn), it is left
+  // so and only the state's solid columns are set (to zero). Most cells of a slide are such: the pass
+  // over all ~27 columns of the sums and ~20 of face fields was most of this phase's time.
   auto marked = ice_->solidCellsToMark();
+  const int touch = mpm::MpmSolver<Dim>::touchColumn(nm);
   // The sums are complete on the ghosts as well, so every local cell is set without a halo exchange.
   Kokkos::parallel_for(
       "mpmice::cellsFromParticles", Kokkos::RangePolicy<ExecutionSpace>(0, state.density.overlapCount()),
       KOKKOS_LAMBDA(const LocalOrdinal c) {
+        if (!marked(c) && sums(c, touch) == 0.0) {
+          // What the full path below sets here: the exchange gives a massless material the
+          // mixture's velocity, so the state's columns are written again.
+          for (int a = 0; a < nm; ++a) {
+            const int m = scene_index[a];
+            change(c, m) = 0.0;
+            rho(c, m) = 0.0;
+            theta(c, m) = 0.0;
+            for (int d = 0; d < Dim; ++d) u(c, m * Dim + d) = 0.0;
+          }
+          return;
+        }
         bool solid = false;  // (a NaN is not zero: the phases' general path reports it)
         // The particles' domains of two solids can overlap in a cell where their particles do not
         // (each fills its own GIMP box): the solids then share the cell in proportion.

@@ -88,3 +88,52 @@ TEST(ParticlesToCells, PlasticDilationIsLeftToTheFluids)
   EXPECT_NEAR(in_cells[0], initial[0], 1e-12 * initial[0]);
   EXPECT_NEAR(in_cells[1], present[1], 1e-12 * present[1]);
 }
+
+// The count of contributions (MpmSolver::touchColumn) is what lets the coupled step pass over the
+// cells that no particle reaches reading one column: wherever it is 0, every other column must be 0
+// too, on owned and ghost cells alike. Two bodies moving at 2 m/s across cell faces within the step
+// (Δt = 2.5e-3 s: a fifth of a cell, so the moved boxes, the layers and the covers over the step all
+// reach beyond the cells the boxes overlap), an elastic one and a moving rigid one (whose face shares
+// take their own path), on 1 and 2 ranks. The test fails if any write of the sums is not counted;
+// it also asserts that the count is not everywhere (most of the cells stay out of reach).
+TEST(ParticlesToCells, CellsWithoutContributionsHoldNothing)
+{
+  Scene scene = scenes::dryScene<2>({0, 0, 0}, {0.24, 0.16, 0}, {24, 16, 1}, {12, 8, 1}, {0, 0, 0});
+  scenes::addLinearElastic(scene, "block", 1000.0, 1.0e6, 0.3, 2);
+  Teuchos::ParameterList plunger;
+  plunger.set("kind", std::string("solid"));
+  plunger.set("density", 2000.0);
+  plunger.set("particles_per_cell", 2);
+  plunger.sublist("model").set("type", std::string("rigid"));
+  plunger.sublist("model").set("velocity", Teuchos::Array<double>{-2.0, 1.0});
+  scene.materials.push_back(MaterialSpec{"plunger", "solid", plunger});
+  scenes::addBox(scene, "block", {0.023, 0.031, 0}, {0.071, 0.067, 0}, {2.0, -1.5, 0});
+  scenes::addBox(scene, "plunger", {0.15, 0.09, 0}, {0.19, 0.13, 0});
+  const auto comm = Tpetra::getDefaultComm();
+  const auto layout = scenes::layoutFor<2>(scene, comm);
+  MpmSolver<2> solver(scene, layout, MpmOptions{});
+  Field<2> cells(layout, Location::Cell, MpmSolver<2>::cellColumns(2), "particle sums");
+  solver.particlesToGrid();
+  solver.integrateGrid(0.0);  // v* = v
+  solver.particlesToCells(cells, 2.5e-3);
+  const auto sums = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), cells.view());
+  const int touch = MpmSolver<2>::touchColumn(2);
+  long long reached = 0, unreached_but_filled = 0, local = 0;
+  for (LocalOrdinal c = 0; c < LocalOrdinal(sums.extent(0)); ++c, ++local) {
+    if (sums(c, touch) > 0) {
+      ++reached;
+      continue;
+    }
+    for (int k = 0; k < cells.columns(); ++k)
+      if (sums(c, k) != 0.0) ++unreached_but_filled;
+  }
+  long long global[3] = {0, 0, 0};
+  const long long counts[3] = {reached, unreached_but_filled, local};
+  Teuchos::reduceAll(*comm, Teuchos::REDUCE_SUM, 3, counts, global);
+  if (comm->getRank() == 0)
+    std::printf("[ cells    ] %lld of %lld local cells reached, %lld values in cells not counted as reached\n", global[0],
+                global[2], global[1]);
+  EXPECT_EQ(global[1], 0);
+  EXPECT_GT(global[0], 0);
+  EXPECT_LT(global[0], global[2] / 2);
+}

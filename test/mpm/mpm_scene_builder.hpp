@@ -8,6 +8,7 @@
 #include <Teuchos_Array.hpp>
 #include <Tpetra_Core.hpp>
 
+#include <array>
 #include <memory>
 #include <string>
 
@@ -49,8 +50,10 @@ inline void addLinearElastic(Scene& scene, const std::string& name, double densi
   scene.materials.push_back(MaterialSpec{name, "solid", list});
 }
 
-/// A rigid body at rest in a 2-D scene (2 particles per cell and direction).
-inline void addRigid(Scene& scene, const std::string& name, double density)
+/// A rigid body in a 2-D scene (2 particles per cell and direction), at rest unless given its
+/// prescribed velocity.
+inline void addRigid(Scene& scene, const std::string& name, double density,
+                     const std::array<double, 2>& velocity = {0.0, 0.0})
 {
   Teuchos::ParameterList list;
   list.set("kind", std::string("solid"));
@@ -58,7 +61,7 @@ inline void addRigid(Scene& scene, const std::string& name, double density)
   list.set("particles_per_cell", 2);
   Teuchos::ParameterList& model = list.sublist("model");
   model.set("type", std::string("rigid"));
-  model.set("velocity", Teuchos::Array<double>(2, 0.0));
+  model.set("velocity", Teuchos::Array<double>(velocity.begin(), velocity.end()));
   scene.materials.push_back(MaterialSpec{name, "solid", list});
 }
 

@@ -100,13 +100,7 @@ TEST(ParticlesToCells, CellsWithoutContributionsHoldNothing)
 {
   Scene scene = scenes::dryScene<2>({0, 0, 0}, {0.24, 0.16, 0}, {24, 16, 1}, {12, 8, 1}, {0, 0, 0});
   scenes::addLinearElastic(scene, "block", 1000.0, 1.0e6, 0.3, 2);
-  Teuchos::ParameterList plunger;
-  plunger.set("kind", std::string("solid"));
-  plunger.set("density", 2000.0);
-  plunger.set("particles_per_cell", 2);
-  plunger.sublist("model").set("type", std::string("rigid"));
-  plunger.sublist("model").set("velocity", Teuchos::Array<double>{-2.0, 1.0});
-  scene.materials.push_back(MaterialSpec{"plunger", "solid", plunger});
+  scenes::addRigid(scene, "plunger", 2000.0, {-2.0, 1.0});
   scenes::addBox(scene, "block", {0.023, 0.031, 0}, {0.071, 0.067, 0}, {2.0, -1.5, 0});
   scenes::addBox(scene, "plunger", {0.15, 0.09, 0}, {0.19, 0.13, 0});
   const auto comm = Tpetra::getDefaultComm();

@@ -1537,8 +1537,10 @@ std::vector<long long> MpmSolver<Dim>::particlesPerPatch() const
     lower[d] = grid.lower()[d], spacing[d] = grid.spacing()[d], cells[d] = grid.cells()[d];
     patch_cells[d] = first_patch.extent(d), patch_counts[d] = grid.patchCounts()[d];
   }
-  Kokkos::parallel_for(
-      "mpm::particlesPerPatch", Kokkos::RangePolicy<ExecutionSpace>(0, particles_.count), KOKKOS_LAMBDA(const int p) {
+  // The particles of rigid materials at rest are passed over by the step's loops, and with
+  // stationary_sums_once their sums are copied in: they are not counted then.
+  const ParticleSet set = options_.stationary_sums_once ? ParticleSet::Changing : ParticleSet::All;
+  forEachParticle("mpm::particlesPerPatch", set, KOKKOS_LAMBDA(const int p) {
         long long patch = 0, stride = 1;
         for (int d = 0; d < Dim; ++d) {
           // Between steps every particle is inside the domain (relocateParticles checked it).

@@ -226,7 +226,8 @@ class MpmSolver {
   // --- diagnostics (collective) ------------------------------------------------------------------
   long long particleCount() const;
   /// Particles in every patch of the grid (indexed by patch id), over all ranks: the particles'
-  /// share of the work when the decomposition is redone.
+  /// share of the work when the decomposition is redone. Those of rigid materials at rest (a bed)
+  /// count only without MpmOptions::stationary_sums_once: the step passes over them otherwise.
   std::vector<long long> particlesPerPatch() const;
   std::vector<double> materialMasses() const;   ///< per MPM material (kg, or kg/m in 2-D)
   double kineticEnergy() const;                 ///< sum of m |v|^2 / 2 (J, or J/m in 2-D)

@@ -74,6 +74,30 @@ Division divisionByOpenCells(const RunState<Dim>& run, double gain)
   return result;
 }
 
+// From the per-phase costs measured on one core (doc/scaling.md, "Weights"; bench/scaling.sh): with
+// moving fluids a cell carries the whole fluid step and a particle its share of phases 1, 2, 9 and
+// 12 and of the sums between steps (the slide: 0.12-0.14 in 2-D, 0.23-0.27 in 3-D in two series of
+// runs); in a dry scene a cell carries only its nodes' share of the grid update (the granular
+// column: 11-12; not measured in 3-D, where the 2-D value is taken). With two constraints the
+// division itself does not depend on them, only the estimated imbalance that decides a move.
+double particleWork(int dimension, bool fluids_move)
+{
+  if (!fluids_move) return 11.0;
+  return dimension == 3 ? 0.25 : 0.13;
+}
+
+template <int Dim>
+Redivision divisionWithParticles(const RunState<Dim>& run, double gain)
+{
+  std::vector<long long> particles;
+  if (const mpm::MpmSolver<Dim>* solids = run.step->particles()) particles = solids->particlesPerPatch();
+  std::vector<long long> closed;
+  if (const IceSolver<Dim>* fluids = run.step->fluids()) closed = fluids->closedCellsPerPatch();
+  const Grid<Dim>& grid = run.layout->grid();
+  const PatchWork work = patchWork(grid, particles, particleWork(Dim, run.step->fluidsMove()), closed);
+  return divideAgain(grid, run.layout->decomposition(), work, gain);
+}
+
 template RunState<2> buildRunState(const Scene&, const Grid<2>&, const Decomposition&,
                                    const Teuchos::RCP<const Teuchos::Comm<int>>&);
 template RunState<3> buildRunState(const Scene&, const Grid<3>&, const Decomposition&,
@@ -84,5 +108,7 @@ template RunState<2> redistribute(const Scene&, RunState<2>&, const Decompositio
 template RunState<3> redistribute(const Scene&, RunState<3>&, const Decomposition&);
 template Division divisionByOpenCells(const RunState<2>&, double);
 template Division divisionByOpenCells(const RunState<3>&, double);
+template Redivision divisionWithParticles(const RunState<2>&, double);
+template Redivision divisionWithParticles(const RunState<3>&, double);
 
 }  // namespace cfdmpm

@@ -89,4 +89,20 @@ struct Division {
 template <int Dim>
 Division divisionByOpenCells(const RunState<Dim>& run, double gain);
 
+/// A new decomposition is taken only when it lowers the estimated imbalance by more than this (a
+/// share of the mean load): a move costs about as much as three steps (doc/scaling.md), which a
+/// gain of 2 % pays back within 150 steps.
+inline constexpr double kRebalanceGain = 0.02;
+
+/// The work of one particle in units of one cell's, for the weights of a division with the
+/// particles (divisionWithParticles; domain.rebalance_interval).
+double particleWork(int dimension, bool fluids_move);
+
+/// The patches divided again (divideAgain) so that the cells' work (the cells rigid bodies fill
+/// weighed kClosedCellWork) and the particles' work (MpmSolver::particlesPerPatch times
+/// particleWork) are each balanced, where that lowers the estimated imbalance by more than `gain`;
+/// else the run's own division. Collective; every rank gets the same answer.
+template <int Dim>
+Redivision divisionWithParticles(const RunState<Dim>& run, double gain);
+
 }  // namespace cfdmpm

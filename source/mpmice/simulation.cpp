@@ -106,22 +106,6 @@ std::string agreedFailure(MPI_Comm comm, const std::string& failure)
   return first == ranks ? std::string() : broadcastText(comm, first, failure);
 }
 
-// The work of one particle in units of one cell's, for the weights of a rebalance
-// (domain.rebalance_interval), from the per-phase costs measured on one core (doc/scaling.md,
-// "Weights"; bench/scaling.sh): with moving fluids a cell carries the whole fluid step and a
-// particle its share of phases 1, 2, 9 and 12 and of the sums between steps (the slide: 0.12-0.14
-// in 2-D, 0.23-0.27 in 3-D in two series of runs); in a dry scene a cell carries only its nodes'
-// share of the grid update (the granular column: 11-12; not measured in 3-D, where the 2-D value
-// is taken).
-double particleWork(int dimension, bool fluids_move)
-{
-  if (!fluids_move) return 11.0;
-  return dimension == 3 ? 0.25 : 0.13;
-}
-// A new decomposition is taken only when it lowers the estimated imbalance by more than this (a
-// share of the mean load): a move costs about as much as three steps (doc/scaling.md), which a gain
-// of 2 % pays back within 150 steps.
-constexpr double kRebalanceGain = 0.02;
 
 /// What redoing the decomposition found: the estimated imbalance (loadImbalance) of the division
 /// before and after, and the patches that changed rank (0: the run kept its division).
@@ -407,19 +391,13 @@ RunSummary run(const Scene& scene, const RunOptions& options, const Teuchos::RCP
   // that do them wait for their own slowest rank; the run moves to the new division (redistribute:
   // the way a restart builds a run, with the state of this one) when its estimated imbalance is
   // lower by more than kRebalanceGain. Every rank computes the same weights and the same division.
-  const double particle_work = particleWork(Dim, fluids_move);
   int rebalance_messages = 0;
   const Teuchos::RCP<Teuchos::Time> rebalance_timer = Teuchos::TimeMonitor::getNewCounter("cfdmpm: rebalance");
   auto rebalance = [&] {
     Teuchos::TimeMonitor timed(*rebalance_timer);
     RebalanceReport result;
-    std::vector<long long> particles;
-    if (const mpm::MpmSolver<Dim>* solids = run_state.step->particles()) particles = solids->particlesPerPatch();
-    std::vector<long long> closed;
-    if (const IceSolver<Dim>* fluids = run_state.step->fluids()) closed = fluids->closedCellsPerPatch();
     const Decomposition& current = run_state.layout->decomposition();
-    const Redivision division =
-        divideAgain(grid, current, patchWork(grid, particles, particle_work, closed), kRebalanceGain);
+    const Redivision division = divisionWithParticles(run_state, kRebalanceGain);
     result.imbalance_before = division.imbalance_before;
     result.imbalance_after = division.imbalance_after;
     const Decomposition& balanced = division.decomposition;

@@ -98,10 +98,46 @@ struct ExchangeSystem {
 
 KOKKOS_INLINE_FUNCTION bool isFinite(double x) { return x - x == 0.0; }
 
-/// The elimination below written out for exactly two materials: the same operations in the same
-/// order, so the results are identical to the bit, without the index lists and loops over runtime
-/// counts. With both present, S = [[w0 + g01, -g01], [-g10, w1 + g10]] and GTH gives the pivots
-/// w0 + g01 and w1 + l w0 (l = g10/(w0 + g01)): sums of non-negative terms, as in the general case.
+/// Two materials a < b, both with mass (weight > 0), exchanging: the elimination below for exactly
+/// these two present, written out (its operations in its order, so that the results are the same to
+/// the bit, without its index lists and loops over runtime counts). S = [[w0 + g01, -g01],
+/// [-g10, w1 + g10]] and GTH gives the pivots w0 + g01 and w1 + l w0 (l = g10/(w0 + g01)): sums of
+/// non-negative terms, as in the general case.
+template <int MaxComponents>
+KOKKOS_INLINE_FUNCTION void eliminatePair(const ExchangeSystem& system, const ExchangeCoefficients& K,
+                                          double (&q)[kMaxMaterials][MaxComponents], int components, int a, int b)
+{
+  const double w0 = system.weight[a], w1 = system.weight[b];
+  const double t0 = system.volume_fraction[a], t1 = system.volume_fraction[b];
+  const double dt = system.dt;
+  const double total_weight = w0 + w1;
+  const double g01 = dt * t0 * t1 * K(a, b);
+  const double g10 = dt * t1 * t0 * K(b, a);
+  const double pivot0 = w0 + g01;
+  const bool eliminate = g10 != 0.0;
+  const double l = eliminate ? g10 / pivot0 : 0.0;
+  const double pivot1 = eliminate ? w1 + l * w0 : w1;
+  for (int c = 0; c < components; ++c) {
+    double sum = 0.0;  // 0.0 + ... as in the general case (the sign of a zero sum)
+    sum += w0 * q[a][c];
+    sum += w1 * q[b][c];
+    const double mean = sum / total_weight;
+    double r0 = w0 * (q[a][c] - mean);
+    double r1 = w1 * (q[b][c] - mean);
+    if (eliminate) r1 += l * r0;
+    r1 = r1 / pivot1;
+    r0 = (r0 + g01 * r1) / pivot0;
+    double drift = 0.0;
+    drift += w0 * r0;
+    drift += w1 * r1;
+    drift /= total_weight;
+    q[a][c] = mean + (r0 - drift);
+    q[b][c] = mean + (r1 - drift);
+  }
+}
+
+/// The elimination below written out for exactly two materials (eliminatePair where both have
+/// mass), the same to the bit.
 template <int MaxComponents>
 KOKKOS_INLINE_FUNCTION ExchangeStatus implicitExchangeTwo(const ExchangeSystem& system,
                                                           const ExchangeCoefficients& K,
@@ -118,30 +154,7 @@ KOKKOS_INLINE_FUNCTION ExchangeStatus implicitExchangeTwo(const ExchangeSystem& 
 
   const double dt = system.dt;
   if (w0 > 0.0 && w1 > 0.0) {
-    const double total_weight = w0 + w1;
-    const double g01 = dt * t0 * t1 * K(0, 1);
-    const double g10 = dt * t1 * t0 * K(1, 0);
-    const double pivot0 = w0 + g01;
-    const bool eliminate = g10 != 0.0;
-    const double l = eliminate ? g10 / pivot0 : 0.0;
-    const double pivot1 = eliminate ? w1 + l * w0 : w1;
-    for (int c = 0; c < components; ++c) {
-      double sum = 0.0;  // 0.0 + ... as in the general case (the sign of a zero sum)
-      sum += w0 * q[0][c];
-      sum += w1 * q[1][c];
-      const double mean = sum / total_weight;
-      double r0 = w0 * (q[0][c] - mean);
-      double r1 = w1 * (q[1][c] - mean);
-      if (eliminate) r1 += l * r0;
-      r1 = r1 / pivot1;
-      r0 = (r0 + g01 * r1) / pivot0;
-      double drift = 0.0;
-      drift += w0 * r0;
-      drift += w1 * r1;
-      drift /= total_weight;
-      q[0][c] = mean + (r0 - drift);
-      q[1][c] = mean + (r1 - drift);
-    }
+    eliminatePair(system, K, q, components, 0, 1);
   } else if (w0 > 0.0 || w1 > 0.0) {
     // One material with mass (a) keeps its value up to round-off; the massless one (b) follows its
     // row of A.
@@ -173,8 +186,43 @@ KOKKOS_INLINE_FUNCTION ExchangeStatus implicitExchangeTwo(const ExchangeSystem& 
   return ExchangeStatus::Ok;
 }
 
-/// The general elimination for any number of materials (Count > 0: fixed at compile time).
-template <int MaxComponents, int Count>
+/// The massless materials (weight 0) of the `count` follow their row of A with the new values of the
+/// `np` present ones (`present`, ascending).
+template <int MaxComponents>
+KOKKOS_INLINE_FUNCTION void followPresent(const ExchangeSystem& system, const ExchangeCoefficients& K,
+                                          double (&q)[kMaxMaterials][MaxComponents], int components, int count,
+                                          const int (&present)[kMaxMaterials], int np)
+{
+  for (int m = 0; m < count; ++m) {
+    if (system.weight[m] > 0.0) continue;
+    double beta_sum = 0.0;
+    double pull[MaxComponents];
+    for (int c = 0; c < components; ++c) pull[c] = 0.0;
+    for (int i = 0; i < np; ++i) {
+      const int n = present[i];
+      const double beta = system.dt * system.rate_scale[m] * system.volume_fraction[n] * K(m, n);
+      beta_sum += beta;
+      for (int c = 0; c < components; ++c) pull[c] += beta * q[n][c];
+    }
+    for (int c = 0; c < components; ++c) q[m][c] = (q[m][c] + pull[c]) / (1.0 + beta_sum);
+  }
+}
+
+/// Ok if every value of the `count` materials is finite, else NonFinite.
+template <int MaxComponents>
+KOKKOS_INLINE_FUNCTION ExchangeStatus finiteValues(const double (&q)[kMaxMaterials][MaxComponents], int components,
+                                                   int count)
+{
+  for (int m = 0; m < count; ++m)
+    for (int c = 0; c < components; ++c)
+      if (!isFinite(q[m][c])) return ExchangeStatus::NonFinite;
+  return ExchangeStatus::Ok;
+}
+
+/// The general elimination for any number of materials (Count > 0: fixed at compile time). With
+/// two of them present it takes eliminatePair (the same to the bit; PairWrittenOut false: the loops,
+/// which the tests compare it with).
+template <int MaxComponents, int Count, bool PairWrittenOut = true>
 KOKKOS_INLINE_FUNCTION ExchangeStatus implicitExchangeGeneral(const ExchangeSystem& system,
                                                               const ExchangeCoefficients& K,
                                                               double (&q)[kMaxMaterials][MaxComponents],
@@ -197,10 +245,16 @@ KOKKOS_INLINE_FUNCTION ExchangeStatus implicitExchangeGeneral(const ExchangeSyst
       present[np++] = m;
       total_weight += system.weight[m];
     }
-    for (int n = 0; n < count; ++n)
+    for (int n = 0; n < count && !coupled; ++n)
       if (n != m && K(m, n) != 0.0) coupled = true;
   }
   if (!coupled) return ExchangeStatus::Ok;  // no exchange: leave the values bit for bit
+  if (PairWrittenOut && np == 2) {
+    // Two present (a cell of the seed scene that no solid reaches: its water and air), written out.
+    eliminatePair(system, K, q, components, present[0], present[1]);
+    followPresent(system, K, q, components, count, present, np);
+    return finiteValues(q, components, count);
+  }
 
   double g[kMaxMaterials][kMaxMaterials];  // couplings among present materials (row i, column j)
   double excess[kMaxMaterials];            // row sums of S over the not yet eliminated columns
@@ -252,25 +306,8 @@ KOKKOS_INLINE_FUNCTION ExchangeStatus implicitExchangeGeneral(const ExchangeSyst
     for (int i = 0; i < np; ++i) q[present[i]][c] = mean[c] + (rhs[i][c] - drift);
   }
 
-  // Massless materials follow their row of A with the new values of the present ones.
-  for (int m = 0; m < count; ++m) {
-    if (system.weight[m] > 0.0) continue;
-    double beta_sum = 0.0;
-    double pull[MaxComponents];
-    for (int c = 0; c < components; ++c) pull[c] = 0.0;
-    for (int i = 0; i < np; ++i) {
-      const int n = present[i];
-      const double beta = system.dt * system.rate_scale[m] * system.volume_fraction[n] * K(m, n);
-      beta_sum += beta;
-      for (int c = 0; c < components; ++c) pull[c] += beta * q[n][c];
-    }
-    for (int c = 0; c < components; ++c) q[m][c] = (q[m][c] + pull[c]) / (1.0 + beta_sum);
-  }
-
-  for (int m = 0; m < count; ++m)
-    for (int c = 0; c < components; ++c)
-      if (!isFinite(q[m][c])) return ExchangeStatus::NonFinite;
-  return ExchangeStatus::Ok;
+  followPresent(system, K, q, components, count, present, np);
+  return finiteValues(q, components, count);
 }
 
 /// Applies the implicit exchange in place to `components` quantities q[m][c] (velocity components,

@@ -146,7 +146,7 @@ class IceSolver {
   /// [5] The pressure matrix's face coefficient with solids for the given outer iteration (from 1):
   /// the derivative of the fluxes that pressureRightHandSide takes at the current face velocities
   /// (see the definition).
-  void carriedFaceBeta(int outer_iteration);
+  void carriedFaceBeta(const CellState<Dim>& state, int outer_iteration);
   /// [10] Advection of the fluids (solids are Lagrangian) and the cell closure θ = ρ v.
   void advectionPhase(CellState<Dim>& state, double dt, IceStepReport& report);
 
@@ -353,6 +353,7 @@ class IceSolver {
   FaceField<Dim> solid_kinematic_velocity_;  // a solid's face velocity before pressure and exchange
   FaceField<Dim> fluid_face_fraction_;  // with solids: a fluid's volume fraction crossing a face (columns 2 m, 2 m + 1: donor below, above)
   typename Advector<Dim>::CapView fluid_outflow_share_;  // with solids: (donor cell, face) share of the fluids' slabs that leaves
+  CellMask fraction_faces_;  // fluidFaceFractions: bit d set where it last set the share of the cell's lower face in direction d below 1 or may have
   Field<Dim> new_velocity_;             // Lagrangian velocities between sources and exchange
   Field<Dim> filter_laplacian_, filter_increment_;  // filterOddEven's work space (1 column when off)
   Field<Dim> old_specific_volume_;      // v before the Lagrangian update (for the p dv work)

@@ -409,6 +409,53 @@ TEST(Exchange, ReportsMaterialCountOutOfRange)
             ExchangeStatus::InvalidInput);
 }
 
+// The general elimination's loops (without its written-out pair, eliminatePair), set up as
+// exchangeMomentumCC and exchangeMomentumFC set it up: the reference of the written-out forms.
+ExchangeStatus loopsCC(int count, double dt, const ExchangeCoefficients& K, const MaterialArray<double>& rho,
+                       const MaterialArray<double>& theta, const MaterialArray<double>& v, MaterialArray<Velocity2>& u)
+{
+  detail::ExchangeSystem system{count, rho, v, theta, dt};
+  double q[kMaxMaterials][2];
+  for (int m = 0; m < count; ++m)
+    for (int d = 0; d < 2; ++d) q[m][d] = u[m][d];
+  const ExchangeStatus status = detail::implicitExchangeGeneral<2, 0, false>(system, K, q, 2);
+  for (int m = 0; m < count; ++m)
+    for (int d = 0; d < 2; ++d) u[m][d] = q[m][d];
+  return status;
+}
+ExchangeStatus loopsFC(int count, double dt, const ExchangeCoefficients& K, const MaterialArray<double>& theta_l,
+                       const MaterialArray<double>& theta_r, const MaterialArray<double>& v_l,
+                       const MaterialArray<double>& v_r, MaterialArray<double>& uf, MaterialArray<double>& vf)
+{
+  detail::ExchangeSystem system{count, {}, {}, {}, dt};
+  double q[kMaxMaterials][2];
+  for (int m = 0; m < count; ++m) {
+    const double v = harmonicMean(v_l[m], v_r[m]);
+    const double theta = 0.5 * (theta_l[m] + theta_r[m]);
+    system.volume_fraction[m] = theta;
+    system.rate_scale[m] = v;
+    system.weight[m] = theta / v;
+    q[m][0] = uf[m];
+    q[m][1] = v;
+  }
+  const ExchangeStatus status = detail::implicitExchangeGeneral<2, 0, false>(system, K, q, 2);
+  for (int m = 0; m < count; ++m) uf[m] = q[m][0], vf[m] = q[m][1];
+  return status;
+}
+
+// The same velocities (and sign of zero) and status from two exchanges (Ok: values compared).
+void expectSameBits(ExchangeStatus s_a, ExchangeStatus s_b, int count, const MaterialArray<Velocity2>& a,
+                    const MaterialArray<Velocity2>& b, int trial)
+{
+  ASSERT_EQ(s_a, s_b) << "trial " << trial;
+  if (s_a != ExchangeStatus::Ok) return;
+  for (int m = 0; m < count; ++m)
+    for (int d = 0; d < 2; ++d) {
+      ASSERT_EQ(std::signbit(a[m][d]), std::signbit(b[m][d])) << "trial " << trial;
+      ASSERT_EQ(a[m][d], b[m][d]) << "trial " << trial << ", material " << m << ", component " << d;
+    }
+}
+
 TEST(Exchange, TwoMaterialFormIsTheGeneralEliminationBitForBit)
 {
   // The kernels call the exchange with the material count fixed at compile time; for two materials
@@ -435,18 +482,14 @@ TEST(Exchange, TwoMaterialFormIsTheGeneralEliminationBitForBit)
       u[m] = {uniform(-3.0, 3.0), trial % 7 == 0 ? -0.0 : uniform(-3.0, 3.0)};
     }
     if (trial % 97 == 0) u[trial % 2][1] = std::nan("");
-    MaterialArray<Velocity2> general = u, two = u;
+    MaterialArray<Velocity2> general = u, two = u, loops = u;
     const ExchangeStatus s_general =
         exchangeMomentumCC<2>(2, dt, ExchangeCoefficients::uniform(K), rho, theta, v, general);
     const ExchangeStatus s_two =
         exchangeMomentumCC<2, 2>(2, dt, ExchangeCoefficients::uniform(K), rho, theta, v, two);
-    ASSERT_EQ(s_general, s_two) << "trial " << trial;
-    if (s_general == ExchangeStatus::Ok)
-      for (int m = 0; m < 2; ++m)
-        for (int d = 0; d < 2; ++d) {
-          ASSERT_EQ(std::signbit(general[m][d]), std::signbit(two[m][d])) << "trial " << trial;
-          ASSERT_EQ(general[m][d], two[m][d]) << "trial " << trial << ", material " << m << ", component " << d;
-        }
+    const ExchangeStatus s_loops = loopsCC(2, dt, ExchangeCoefficients::uniform(K), rho, theta, v, loops);
+    expectSameBits(s_loops, s_two, 2, loops, two, trial);
+    expectSameBits(s_loops, s_general, 2, loops, general, trial);
 
     MaterialArray<double> theta_r{}, v_r{}, uf{}, vf_general{}, vf_two{};
     for (int m = 0; m < 2; ++m) {
@@ -454,16 +497,21 @@ TEST(Exchange, TwoMaterialFormIsTheGeneralEliminationBitForBit)
       v_r[m] = v[m] * uniform(0.99, 1.01);
       uf[m] = u[m][0];
     }
-    MaterialArray<double> uf_general = uf, uf_two = uf;
+    MaterialArray<double> uf_general = uf, uf_two = uf, uf_loops = uf, vf_loops{};
     const ExchangeStatus f_general = exchangeMomentumFC(2, dt, ExchangeCoefficients::uniform(K), theta, theta_r, v,
                                                         v_r, uf_general, vf_general);
     const ExchangeStatus f_two = exchangeMomentumFC<2>(2, dt, ExchangeCoefficients::uniform(K), theta, theta_r, v,
                                                        v_r, uf_two, vf_two);
-    ASSERT_EQ(f_general, f_two) << "trial " << trial;
-    if (f_general == ExchangeStatus::Ok)
+    const ExchangeStatus f_loops =
+        loopsFC(2, dt, ExchangeCoefficients::uniform(K), theta, theta_r, v, v_r, uf_loops, vf_loops);
+    ASSERT_EQ(f_general, f_loops) << "trial " << trial;
+    ASSERT_EQ(f_two, f_loops) << "trial " << trial;
+    if (f_loops == ExchangeStatus::Ok)
       for (int m = 0; m < 2; ++m) {
-        ASSERT_EQ(uf_general[m], uf_two[m]) << "trial " << trial;
-        ASSERT_EQ(vf_general[m], vf_two[m]) << "trial " << trial;
+        ASSERT_EQ(uf_general[m], uf_loops[m]) << "trial " << trial;
+        ASSERT_EQ(vf_general[m], vf_loops[m]) << "trial " << trial;
+        ASSERT_EQ(uf_two[m], uf_loops[m]) << "trial " << trial;
+        ASSERT_EQ(vf_two[m], vf_loops[m]) << "trial " << trial;
       }
     ++cases;
   }
@@ -473,4 +521,63 @@ TEST(Exchange, TwoMaterialFormIsTheGeneralEliminationBitForBit)
   MaterialArray<Velocity2> u{};
   EXPECT_EQ((exchangeMomentumCC<2, 2>(3, 1e-4, ExchangeCoefficients::uniform(1e15), rho, theta, v, u)),
             ExchangeStatus::InvalidInput);
+}
+
+TEST(Exchange, FourMaterialsWithTwoPresentAreTheLoopsBitForBit)
+{
+  // Four materials (the seed scene's bed, sand, water and air), each without mass, a trace or a
+  // share of the cell, so that 0 to 4 are present: the exchange with its pair written out (two
+  // present, e.g. water and air where no solid is) gives the loops' results to the bit, with a
+  // uniform K and with the seed scene's pattern (the fluids' pair 1e3, a solid and a fluid 1e15,
+  // the two solids 0), and non-finite input.
+  unsigned state = 2468;
+  const auto uniform = [&state](double lo, double hi) {
+    state = state * 1664525u + 1013904223u;
+    return lo + (hi - lo) * double(state >> 8) / double(1u << 24);
+  };
+  const auto seed = [] {
+    ExchangeCoefficients k = ExchangeCoefficients::uniform(1e15);
+    k.set(0, 1, 0.0);
+    k.set(2, 3, 1e3);
+    return k;
+  }();
+  const ExchangeCoefficients coefficients[3] = {ExchangeCoefficients::uniform(1e3), seed,
+                                                ExchangeCoefficients::uniform(0.0)};
+  int pairs = 0;
+  for (int trial = 0; trial < 6000; ++trial) {
+    const ExchangeCoefficients& K = coefficients[trial % 3];
+    const double dt = uniform(1e-6, 1e-3);
+    MaterialArray<double> theta{}, v{}, rho{}, theta_r{}, v_r{}, uf{};
+    MaterialArray<Velocity2> u{};
+    int present = 0;
+    for (int m = 0; m < 4; ++m) {
+      const int kind = int(uniform(0.0, 3.0 - 1e-9));  // 0: without mass, 1: a trace, 2: a share of the cell
+      const int k = m < 2 && trial % 2 == 0 ? 0 : kind;  // half the trials without solids, as most cells
+      theta[m] = k == 0 ? 0.0 : k == 1 ? uniform(1e-300, 1e-12) : uniform(0.0, 1.0);
+      v[m] = m < 2 ? uniform(3e-4, 6e-4) : m == 2 ? uniform(9e-4, 1.1e-3) : uniform(0.7, 0.9);
+      rho[m] = theta[m] / v[m];
+      present += rho[m] > 0;
+      u[m] = {uniform(-3.0, 3.0), trial % 7 == 0 ? -0.0 : uniform(-3.0, 3.0)};
+      theta_r[m] = trial % 5 == 0 ? 0.0 : uniform(0.0, 1.0);
+      v_r[m] = v[m] * uniform(0.99, 1.01);
+      uf[m] = u[m][0];
+    }
+    if (trial % 97 == 0) u[trial % 4][1] = std::nan("");
+    pairs += present == 2;
+    MaterialArray<Velocity2> fixed = u, loops = u;
+    const ExchangeStatus s_fixed = exchangeMomentumCC<2, 4>(4, dt, K, rho, theta, v, fixed);
+    const ExchangeStatus s_loops = loopsCC(4, dt, K, rho, theta, v, loops);
+    expectSameBits(s_loops, s_fixed, 4, loops, fixed, trial);
+
+    MaterialArray<double> uf_fixed = uf, uf_loops = uf, vf_fixed{}, vf_loops{};
+    const ExchangeStatus f_fixed = exchangeMomentumFC<4>(4, dt, K, theta, theta_r, v, v_r, uf_fixed, vf_fixed);
+    const ExchangeStatus f_loops = loopsFC(4, dt, K, theta, theta_r, v, v_r, uf_loops, vf_loops);
+    ASSERT_EQ(f_fixed, f_loops) << "trial " << trial;
+    if (f_loops == ExchangeStatus::Ok)
+      for (int m = 0; m < 4; ++m) {
+        ASSERT_EQ(uf_fixed[m], uf_loops[m]) << "trial " << trial;
+        ASSERT_EQ(vf_fixed[m], vf_loops[m]) << "trial " << trial;
+      }
+  }
+  EXPECT_GT(pairs, 1000);  // the written-out pair was taken often (about a third of the trials)
 }

@@ -1636,10 +1636,15 @@ void IceSolver<Dim>::filterOddEven(const CellState<Dim>& state)
   // The odd-even mode of one direction is an eigenvector of δ² with eigenvalue −4, of δ⁴ with 16.
   const double kappa = settings_.odd_even_filter / 16.0;
   if (!(kappa > 0)) return;
-  const int columns = materials_ * Dim;
+  // The fluids' velocity columns, in order: a solid's are not filtered (its level and increment
+  // stay zero, and are neither written nor read).
+  Kokkos::Array<int, ice::kMaxMaterials * 3> fluid_column{};
+  int columns = 0;
+  for (int m = 0; m < materials_; ++m)
+    if (!roles_.solid(m))
+      for (int k = 0; k < Dim; ++k) fluid_column[columns++] = m * Dim + k;
   const auto neighbours = layout_->cellNeighbours();
   const auto rho = state.density.view();
-  const auto roles = roles_;
   const auto closed = closed_;
   auto un = new_velocity_.view();
   auto increment = filter_increment_.view();
@@ -1681,10 +1686,10 @@ void IceSolver<Dim>::filterOddEven(const CellState<Dim>& state)
     Kokkos::parallel_for(
         "ice::filterLaplacian", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
         KOKKOS_LAMBDA(const LocalOrdinal c) {
-          for (int col = 0; col < columns; ++col) {
-            const int m = col / Dim;
+          for (int i = 0; i < columns; ++i) {
+            const int col = fluid_column[i], m = col / Dim;
             const double rc = rho(c, m);
-            const bool filtered = !roles.solid(m) && rc > 0 && !closed(c);
+            const bool filtered = rc > 0 && !closed(c);
             laplacian(c, col) = filtered ? weightedDifference(c, col, rc, un) / rc : 0.0;
           }
         });
@@ -1697,10 +1702,10 @@ void IceSolver<Dim>::filterOddEven(const CellState<Dim>& state)
     Kokkos::parallel_for(
         "ice::filterFlux", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
         KOKKOS_LAMBDA(const LocalOrdinal c) {
-          for (int col = 0; col < columns; ++col) {
-            const int m = col / Dim;
+          for (int i = 0; i < columns; ++i) {
+            const int col = fluid_column[i], m = col / Dim;
             const double rc = rho(c, m);
-            if (roles.solid(m) || !(rc > 0) || closed(c)) continue;
+            if (!(rc > 0) || closed(c)) continue;
             increment(c, col) -= kappa * weightedDifference(c, col, rc, laplacian) / rc;
           }
         });
@@ -1708,7 +1713,7 @@ void IceSolver<Dim>::filterOddEven(const CellState<Dim>& state)
   Kokkos::parallel_for(
       "ice::filterApply", Kokkos::RangePolicy<ExecutionSpace>(0, layout_->ownedCells()),
       KOKKOS_LAMBDA(const LocalOrdinal c) {
-        for (int col = 0; col < columns; ++col) un(c, col) += increment(c, col);
+        for (int i = 0; i < columns; ++i) un(c, fluid_column[i]) += increment(c, fluid_column[i]);
       });
 }
 

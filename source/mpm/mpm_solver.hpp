@@ -169,6 +169,16 @@ class MpmSolver {
   /// velocity): particle steps inside the fluids' step cannot take a forecast from one grid update
   /// Δt long, which would be unstable for the particles' elastic wave.
   void particlesToCells(Field<Dim>& sums, double dt = 0.0, bool forecast = false);
+  /// What particlesToCells adds to every local cell for the particles of rigid materials at rest,
+  /// made once on this rank (before the sums across ranks), in its columns; empty where those are
+  /// summed at every step (MpmOptions::stationary_sums_once off, or no material at rest). A cell
+  /// whose contributions (touchColumn) after particlesToCells number as many as here got nothing
+  /// else: its row of the sums is this row.
+  typename Field<Dim>::ConstView stationaryCellSums() const
+  {
+    return stationary_cells_.valid ? typename Field<Dim>::ConstView(stationary_cells_.values)
+                                   : typename Field<Dim>::ConstView();
+  }
   /// Own motion over a coupled step with particle steps inside it: startOwnMotion before the
   /// particle steps marks each particle's velocity plus the velocity change the fluids give it in
   /// the step (Particles::velocity_change); recordOwnAcceleration after them makes

@@ -46,6 +46,7 @@ MpmIceStep<Dim>::MpmIceStep(const Scene& scene, std::shared_ptr<const Layout<Dim
     // rest, so that the first equilibration starts from full cells.
     const int columns = mpm::MpmSolver<Dim>::cellColumns(int(mpm_->materials().size()));
     cell_sums_ = std::make_unique<Field<Dim>>(layout_, Location::Cell, columns, "solid cell sums");
+    stationary_rows_ = Kokkos::View<unsigned char*, MemorySpace>("cells of the solids at rest alone", cell_sums_->overlapCount());
     cell_change_ = std::make_unique<Field<Dim>>(layout_, Location::Cell, columns, "solid velocity change");
     solid_velocity_ = std::make_unique<Field<Dim>>(layout_, Location::Cell, int(mpm_->materials().size()) * Dim,
                                                    "solid cell velocity");
@@ -294,10 +295,42 @@ void MpmIceStep<Dim>::cellsFromParticles(CellState<Dim>& state, double dt)
   // over all ~27 columns of the sums and ~20 of face fields was most of this phase's time.
   auto marked = ice_->solidCellsToMark();
   const int touch = mpm::MpmSolver<Dim>::touchColumn(nm);
+  // A cell that only the particles at rest reach (a bed's) has the same row of sums at every step
+  // (MpmSolver::stationaryCellSums): where it had at the last call too, its face shares and covers
+  // are those it holds, and only the state's solid columns, which the fluids' phases change, are
+  // set again. On the seed scene they are most of the cells that particles reach (its bed).
+  const auto stationary = mpm_->stationaryCellSums();
+  const bool any_stationary = stationary.extent(0) > 0;
+  auto rows = stationary_rows_;
+  // The state's columns of solid a from its sums; returns whether the solid is in the cell.
+  const auto setStateColumns = KOKKOS_LAMBDA(const LocalOrdinal c, const double scale, const int a)->bool
+  {
+    const int m = scene_index[a];
+    change(c, m) = (sums(c, mpm::MpmSolver<Dim>::predictedVolumeColumn(nm, a)) - sums(c, nm + a)) / volume;
+    const double mass = sums(c, a);
+    rho(c, m) = mass / volume;
+    theta(c, m) = scale * sums(c, nm + a) / volume;
+    for (int d = 0; d < Dim; ++d) {
+      const double velocity = mass > 0 ? sums(c, 2 * nm + a * Dim + d) / mass : 0.0;
+      u(c, m * Dim + d) = velocity;
+      solid_u(c, a * Dim + d) = velocity;
+    }
+    return rho(c, m) != 0.0 || theta(c, m) != 0.0;
+  };
   // The sums are complete on the ghosts as well, so every local cell is set without a halo exchange.
   Kokkos::parallel_for(
       "mpmice::cellsFromParticles", Kokkos::RangePolicy<ExecutionSpace>(0, state.density.overlapCount()),
       KOKKOS_LAMBDA(const LocalOrdinal c) {
+        const bool at_rest_alone =
+            any_stationary && stationary(c, touch) > 0.0 && sums(c, touch) == stationary(c, touch);
+        if (at_rest_alone && (rows(c) & 1)) {
+          double solid_volume = 0;
+          for (int a = 0; a < nm; ++a) solid_volume += sums(c, nm + a);
+          const double scale = solid_volume > volume ? volume / solid_volume : 1.0;
+          for (int a = 0; a < nm; ++a) setStateColumns(c, scale, a);
+          marked(c) = (rows(c) >> 1) & 1;
+          return;
+        }
         if (!marked(c) && sums(c, touch) == 0.0) {
           // What the full path below sets here: the exchange gives a massless material the
           // mixture's velocity, so the state's columns are written again.
@@ -326,18 +359,10 @@ void MpmIceStep<Dim>::cellsFromParticles(CellState<Dim>& state, double dt)
               face_cover[d](c, 2 * m + side) = cover;
               solid = solid || share != 0.0 || cover != 0.0;
             }
-          change(c, m) = (sums(c, mpm::MpmSolver<Dim>::predictedVolumeColumn(nm, a)) - sums(c, nm + a)) / volume;
-          const double mass = sums(c, a);
-          rho(c, m) = mass / volume;
-          theta(c, m) = scale * sums(c, nm + a) / volume;
-          solid = solid || rho(c, m) != 0.0 || theta(c, m) != 0.0;
-          for (int d = 0; d < Dim; ++d) {
-            const double velocity = mass > 0 ? sums(c, 2 * nm + a * Dim + d) / mass : 0.0;
-            u(c, m * Dim + d) = velocity;
-            solid_u(c, a * Dim + d) = velocity;
-          }
+          solid = setStateColumns(c, scale, a) || solid;
         }
         marked(c) = solid ? 1 : 0;
+        rows(c) = static_cast<unsigned char>((at_rest_alone ? 1 : 0) | (solid ? 2 : 0));
       });
 }
 

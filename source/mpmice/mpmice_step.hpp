@@ -68,6 +68,9 @@ class MpmIceStep {
   IceSolver<Dim>* fluids() { return ice_.get(); }
   mpm::MpmSolver<Dim>* particles() { return mpm_.get(); }
   const mpm::MpmSolver<Dim>* particles() const { return mpm_.get(); }
+  /// The particles' sums per cell of the last step (MpmSolver::particlesToCells; null without
+  /// fluids or particles): the face shares and covers the fluids hold are their columns.
+  const Field<Dim>* cellSums() const { return cell_sums_.get(); }
 
   /// The phases, timed by Teuchos timers named "mpmice: <phase>" ("step" is the whole step).
   static constexpr const char* kPhases[] = {"step",     "1 particles to grid", "2 particles to cells",
@@ -98,6 +101,10 @@ class MpmIceStep {
   std::unique_ptr<Field<Dim>> cell_sums_;       // particlesToCells: mass, volume, momentum per solid
   std::unique_ptr<Field<Dim>> cell_change_;     // velocity change of the solids' cells (same columns)
   std::unique_ptr<Field<Dim>> solid_velocity_;  // the solids' cell velocity from the particles
+  /// cellsFromParticles, per local cell: bit 0 where its sums were the particles' at rest alone
+  /// (MpmSolver::stationaryCellSums) and it set the face shares and covers from them, bit 1 where
+  /// the cell then held a solid.
+  Kokkos::View<unsigned char*, MemorySpace> stationary_rows_;
   /// Most particle steps in one step (mpm.substeps with fluids and particles, else 1). Above 1 the
   /// solids' velocity forecast for the fluids comes from each particle's own acceleration of the
   /// last step (MpmSolver::particlesToCells), not from one grid update.

@@ -461,6 +461,57 @@ TEST(CoupledStep, CellsThatARigidBodyFillsAreWalls)
   EXPECT_LE(worst, 0.01 * rho_w * g * h);
 }
 
+// The solids' face shares and covers that the fluids take are the particles' sums of the step
+// (MpmSolver::particlesToCells) in every local cell, also where the coupled step passes over the
+// cells that only a rigid body at rest reaches (their sums and shares are the same at every step;
+// MpmIceStep::cellsFromParticles keeps them). An elastic block slides at 1 m/s along a rigid bed
+// under water, so that the cells at its trailing edge go from the block and the bed to the bed
+// alone; after every step the shares and covers must equal the sums' columns exactly (each is a
+// copy of one of them), on 1 and 2 ranks.
+TEST(CoupledStep, FaceSharesAreTheParticlesSumsWhereABedAloneIs)
+{
+  const std::string solids = std::string(kRigidBlock) + R"(    block:
+      kind: solid
+      density: 1500.0
+      particles_per_cell: 2
+      model: {type: linear_elastic, youngs_modulus: 1.0e6, poisson_ratio: 0.3}
+)";
+  const std::string regions = "    b: {material: bed, shape: box, lower: [0.0, 0.0], upper: [0.4, 0.05]}\n"
+                              "    k: {material: block, shape: box, velocity: [1.0, 0.0], lower: [0.05, 0.05], upper: [0.12, 0.09]}";
+  CoupledRun<2> run(sceneFromYaml(tankScene(0.4, 0.2, 40, 20, 0.2, solids, regions)), world());
+  const int nm = 2, touch = mpm::MpmSolver<2>::touchColumn(nm);
+  const int scene_index[2] = {0, 1};  // bed, block (then water)
+  long long compared = 0, differing = 0, bed_alone = 0;
+  run.runUntil(0.03, [&] {
+    const auto sums = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), run.stepper.cellSums()->view());
+    const auto stationary = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), run.stepper.particles()->stationaryCellSums());
+    ASSERT_GT(stationary.extent(0), 0u);  // the bed's sums are made once
+    for (int d = 0; d < 2; ++d) {
+      const auto share = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), run.stepper.fluids()->solidFaceShares().direction(d).view());
+      const auto cover = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), run.stepper.fluids()->solidFaceCovers().direction(d).view());
+      for (std::size_t c = 0; c < sums.extent(0); ++c) {
+        if (d == 0 && stationary(c, touch) > 0 && sums(c, touch) == stationary(c, touch)) ++bed_alone;
+        for (int a = 0; a < nm; ++a)
+          for (int side = 0; side < 2; ++side) {
+            const int m = scene_index[a];
+            ++compared;
+            if (share(c, 2 * m + side) != sums(c, mpm::MpmSolver<2>::faceColumn(nm, a, d, side))) ++differing;
+            if (cover(c, 2 * m + side) != sums(c, mpm::MpmSolver<2>::roomColumn(nm, a, d, side))) ++differing;
+          }
+      }
+    }
+  });
+  compared = globalSum(*world(), double(compared));
+  differing = globalSum(*world(), double(differing));
+  bed_alone = globalSum(*world(), double(bed_alone));
+  if (world()->getRank() == 0)
+    std::printf("[ shares   ] %lld steps, %lld values compared, %lld differ; cells of the bed alone over the steps %lld\n",
+                run.steps, compared, differing, bed_alone);
+  EXPECT_EQ(differing, 0);
+  EXPECT_GT(bed_alone, 100 * run.steps);  // most of the bed's cells: the passed-over path was taken
+  EXPECT_GE(run.steps, 10);
+}
+
 // The division of the patches by their open cells (divisionByOpenCells): the same tank in 32
 // patches of 5 x 5 cells, 8 of them inside the block. By cell counts 2 ranks get the left and the
 // right half, the block's patches all on the left (work 8 x 0.5 + 8 against 16 patches: imbalance

@@ -168,6 +168,8 @@ class MpmSolver {
   /// acceleration of the last coupled step, recordOwnAcceleration; a rigid particle's: its prescribed
   /// velocity): particle steps inside the fluids' step cannot take a forecast from one grid update
   /// Δt long, which would be unstable for the particles' elastic wave.
+  /// `sums` holds what the last call left in it, or zeros: with the sums of particles at rest made
+  /// once, a row whose count (touchColumn) is theirs is taken to hold their row already.
   void particlesToCells(Field<Dim>& sums, double dt = 0.0, bool forecast = false);
   /// What particlesToCells adds to every local cell for the particles of rigid materials at rest,
   /// made once on this rank (before the sums across ranks), in its columns; empty where those are
@@ -320,9 +322,11 @@ class MpmSolver {
   void refreshChangingList() const;
   /// The scatter `f` of every particle into `sums` (zeroed first), the particles of rigid
   /// materials at rest summed once into `stationary` and copied in (MpmOptions::stationary_sums_once).
+  /// With a `count_column` (particlesToCells' touchColumn), only the rows whose count differs from
+  /// the stationary one are copied: the others got nothing since and hold the stationary row.
   template <class F>
   void scatterWithStationarySums(const char* label, const BoxLookup& lookup, Field<Dim>& sums,
-                                 StationarySums& stationary, const F& f);
+                                 StationarySums& stationary, const F& f, int count_column = -1);
   void allocateNodeFields();
 
   std::shared_ptr<const Layout<Dim>> layout_;

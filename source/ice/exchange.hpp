@@ -314,13 +314,17 @@ KOKKOS_INLINE_FUNCTION ExchangeStatus implicitExchangeGeneral(const ExchangeSyst
 /// a temperature, a specific volume). Returns Ok unless something is not finite.
 /// Count > 0 fixes the number of materials at compile time (it must equal system.count): Count = 2
 /// takes the written-out elimination (implicitExchangeTwo), other counts the general one.
-template <int MaxComponents, int Count = 0>
+/// Loops = true: the general elimination's loops throughout (no written-out form; the tests'
+/// reference for them).
+template <int MaxComponents, int Count = 0, bool Loops = false>
 KOKKOS_INLINE_FUNCTION ExchangeStatus implicitExchange(const ExchangeSystem& system,
                                                        const ExchangeCoefficients& K,
                                                        double (&q)[kMaxMaterials][MaxComponents],
                                                        int components)
 {
-  if constexpr (Count == 2)
+  if constexpr (Loops)
+    return implicitExchangeGeneral<MaxComponents, 0, false>(system, K, q, components);
+  else if constexpr (Count == 2)
     return implicitExchangeTwo<MaxComponents>(system, K, q, components);
   else
     return implicitExchangeGeneral<MaxComponents, Count>(system, K, q, components);
@@ -334,8 +338,9 @@ KOKKOS_INLINE_FUNCTION ExchangeStatus implicitExchange(const ExchangeSystem& sys
 ///   velocity[m] [m/s], Dim components, replaced by the exchanged velocity.
 /// The symmetric form uses w_m = mass_density[m]; it equals Uintah's beta when
 /// mass_density = volume_fraction/specific_volume, as after the equilibration.
-/// Count > 0: the number of materials fixed at compile time (count must equal it; see implicitExchange).
-template <int Dim, int Count = 0>
+/// Count > 0: the number of materials fixed at compile time (count must equal it; see implicitExchange,
+/// also for Loops).
+template <int Dim, int Count = 0, bool Loops = false>
 KOKKOS_INLINE_FUNCTION ExchangeStatus exchangeMomentumCC(int count, double dt, const ExchangeCoefficients& K,
                                                          const MaterialArray<double>& mass_density,
                                                          const MaterialArray<double>& volume_fraction,
@@ -349,7 +354,7 @@ KOKKOS_INLINE_FUNCTION ExchangeStatus exchangeMomentumCC(int count, double dt, c
   double q[kMaxMaterials][Dim];
   for (int m = 0; m < n; ++m)
     for (int d = 0; d < Dim; ++d) q[m][d] = velocity[m][d];
-  const ExchangeStatus status = detail::implicitExchange<Dim, Count>(system, K, q, Dim);
+  const ExchangeStatus status = detail::implicitExchange<Dim, Count, Loops>(system, K, q, Dim);
   for (int m = 0; m < n; ++m)
     for (int d = 0; d < Dim; ++d) velocity[m][d] = q[m][d];
   return status;
@@ -395,8 +400,8 @@ KOKKOS_INLINE_FUNCTION double harmonicMean(double a, double b)
 /// on each material's face velocity after the exchange (the pressure equation's coefficient). One
 /// material, or K = 0, gives the harmonic mean itself; K -> infinity gives sum theta/sum(theta/v),
 /// the mixture's specific volume, for every material.
-/// Count > 0: the number of materials fixed at compile time, as for exchangeMomentumCC.
-template <int Count = 0>
+/// Count > 0: the number of materials fixed at compile time, and Loops, as for exchangeMomentumCC.
+template <int Count = 0, bool Loops = false>
 KOKKOS_INLINE_FUNCTION ExchangeStatus exchangeMomentumFC(int count, double dt, const ExchangeCoefficients& K,
                                                          const MaterialArray<double>& volume_fraction_left,
                                                          const MaterialArray<double>& volume_fraction_right,
@@ -421,7 +426,7 @@ KOKKOS_INLINE_FUNCTION ExchangeStatus exchangeMomentumFC(int count, double dt, c
     q[m][0] = face_velocity[m];
     q[m][1] = v;
   }
-  const ExchangeStatus status = detail::implicitExchange<2, Count>(system, K, q, 2);
+  const ExchangeStatus status = detail::implicitExchange<2, Count, Loops>(system, K, q, 2);
   for (int m = 0; m < n; ++m) {
     face_velocity[m] = q[m][0];
     face_specific_volume[m] = q[m][1];

@@ -409,38 +409,18 @@ TEST(Exchange, ReportsMaterialCountOutOfRange)
             ExchangeStatus::InvalidInput);
 }
 
-// The general elimination's loops (without its written-out pair, eliminatePair), set up as
-// exchangeMomentumCC and exchangeMomentumFC set it up: the reference of the written-out forms.
+// The general elimination's loops throughout (Loops = true: without its written-out pair,
+// eliminatePair, or the two-material form): the reference of the written-out forms.
 ExchangeStatus loopsCC(int count, double dt, const ExchangeCoefficients& K, const MaterialArray<double>& rho,
                        const MaterialArray<double>& theta, const MaterialArray<double>& v, MaterialArray<Velocity2>& u)
 {
-  detail::ExchangeSystem system{count, rho, v, theta, dt};
-  double q[kMaxMaterials][2];
-  for (int m = 0; m < count; ++m)
-    for (int d = 0; d < 2; ++d) q[m][d] = u[m][d];
-  const ExchangeStatus status = detail::implicitExchangeGeneral<2, 0, false>(system, K, q, 2);
-  for (int m = 0; m < count; ++m)
-    for (int d = 0; d < 2; ++d) u[m][d] = q[m][d];
-  return status;
+  return exchangeMomentumCC<2, 0, true>(count, dt, K, rho, theta, v, u);
 }
 ExchangeStatus loopsFC(int count, double dt, const ExchangeCoefficients& K, const MaterialArray<double>& theta_l,
                        const MaterialArray<double>& theta_r, const MaterialArray<double>& v_l,
                        const MaterialArray<double>& v_r, MaterialArray<double>& uf, MaterialArray<double>& vf)
 {
-  detail::ExchangeSystem system{count, {}, {}, {}, dt};
-  double q[kMaxMaterials][2];
-  for (int m = 0; m < count; ++m) {
-    const double v = harmonicMean(v_l[m], v_r[m]);
-    const double theta = 0.5 * (theta_l[m] + theta_r[m]);
-    system.volume_fraction[m] = theta;
-    system.rate_scale[m] = v;
-    system.weight[m] = theta / v;
-    q[m][0] = uf[m];
-    q[m][1] = v;
-  }
-  const ExchangeStatus status = detail::implicitExchangeGeneral<2, 0, false>(system, K, q, 2);
-  for (int m = 0; m < count; ++m) uf[m] = q[m][0], vf[m] = q[m][1];
-  return status;
+  return exchangeMomentumFC<0, true>(count, dt, K, theta_l, theta_r, v_l, v_r, uf, vf);
 }
 
 // The same velocities (and sign of zero) and status from two exchanges (Ok: values compared).

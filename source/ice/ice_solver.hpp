@@ -351,9 +351,9 @@ class IceSolver {
   long long first_failed_equilibration_ = -1;  // firstFailedEquilibration()
   Field<Dim> solid_volume_change_;      // solidVolumeChange()
   FaceField<Dim> solid_kinematic_velocity_;  // a solid's face velocity before pressure and exchange
-  FaceField<Dim> fluid_face_fraction_;  // with solids: a fluid's volume fraction crossing a face (columns 2 m, 2 m + 1: donor below, above)
+  FaceField<Dim> fluid_face_fraction_;  // with solids: a fluid's volume fraction crossing a face that a solid is on (columns 2 m, 2 m + 1: donor below, above; solidOnFace)
   typename Advector<Dim>::CapView fluid_outflow_share_;  // with solids: (donor cell, face) share of the fluids' slabs that leaves
-  CellMask fraction_faces_;  // fluidFaceFractions: bit d set where it last set the share of the cell's lower face in direction d below 1 or may have
+  CellMask fraction_faces_;  // fluidFaceFractions: bit d set where it set the outflow shares of the cell's lower face in direction d (a solid on it)
   Field<Dim> new_velocity_;             // Lagrangian velocities between sources and exchange
   Field<Dim> filter_laplacian_, filter_increment_;  // filterOddEven's work space (1 column when off)
   Field<Dim> old_specific_volume_;      // v before the Lagrangian update (for the p dv work)

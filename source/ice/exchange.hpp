@@ -220,9 +220,9 @@ KOKKOS_INLINE_FUNCTION ExchangeStatus finiteValues(const double (&q)[kMaxMateria
 }
 
 /// The general elimination for any number of materials (Count > 0: fixed at compile time). With
-/// two of them present it takes eliminatePair (the same to the bit; PairWrittenOut false: the loops,
+/// two of them present it takes eliminatePair (the same to the bit; Loops: the loops throughout,
 /// which the tests compare it with).
-template <int MaxComponents, int Count, bool PairWrittenOut = true>
+template <int MaxComponents, int Count, bool Loops = false>
 KOKKOS_INLINE_FUNCTION ExchangeStatus implicitExchangeGeneral(const ExchangeSystem& system,
                                                               const ExchangeCoefficients& K,
                                                               double (&q)[kMaxMaterials][MaxComponents],
@@ -249,7 +249,7 @@ KOKKOS_INLINE_FUNCTION ExchangeStatus implicitExchangeGeneral(const ExchangeSyst
       if (n != m && K(m, n) != 0.0) coupled = true;
   }
   if (!coupled) return ExchangeStatus::Ok;  // no exchange: leave the values bit for bit
-  if (PairWrittenOut && np == 2) {
+  if (!Loops && np == 2) {
     // Two present (a cell of the seed scene that no solid reaches: its water and air), written out.
     eliminatePair(system, K, q, components, present[0], present[1]);
     followPresent(system, K, q, components, count, present, np);
@@ -323,7 +323,7 @@ KOKKOS_INLINE_FUNCTION ExchangeStatus implicitExchange(const ExchangeSystem& sys
                                                        int components)
 {
   if constexpr (Loops)
-    return implicitExchangeGeneral<MaxComponents, 0, false>(system, K, q, components);
+    return implicitExchangeGeneral<MaxComponents, 0, true>(system, K, q, components);
   else if constexpr (Count == 2)
     return implicitExchangeTwo<MaxComponents>(system, K, q, components);
   else

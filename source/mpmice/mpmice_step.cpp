@@ -302,20 +302,29 @@ void MpmIceStep<Dim>::cellsFromParticles(CellState<Dim>& state, double dt)
   const auto stationary = mpm_->stationaryCellSums();
   const bool any_stationary = stationary.extent(0) > 0;
   auto rows = stationary_rows_;
-  // The state's columns of solid a from its sums; returns whether the solid is in the cell.
-  const auto setStateColumns = KOKKOS_LAMBDA(const LocalOrdinal c, const double scale, const int a)->bool
+  // The state's columns of every solid from its sums; returns whether a solid is in the cell. The
+  // particles' domains of two solids can overlap in a cell where their particles do not (each fills
+  // its own GIMP box): the solids then share the cell in proportion.
+  const auto setStateColumns = KOKKOS_LAMBDA(const LocalOrdinal c)->bool
   {
-    const int m = scene_index[a];
-    change(c, m) = (sums(c, mpm::MpmSolver<Dim>::predictedVolumeColumn(nm, a)) - sums(c, nm + a)) / volume;
-    const double mass = sums(c, a);
-    rho(c, m) = mass / volume;
-    theta(c, m) = scale * sums(c, nm + a) / volume;
-    for (int d = 0; d < Dim; ++d) {
-      const double velocity = mass > 0 ? sums(c, 2 * nm + a * Dim + d) / mass : 0.0;
-      u(c, m * Dim + d) = velocity;
-      solid_u(c, a * Dim + d) = velocity;
+    double solid_volume = 0;
+    for (int a = 0; a < nm; ++a) solid_volume += sums(c, nm + a);
+    const double scale = solid_volume > volume ? volume / solid_volume : 1.0;
+    bool solid = false;  // (a NaN is not zero: the phases' general path reports it)
+    for (int a = 0; a < nm; ++a) {
+      const int m = scene_index[a];
+      change(c, m) = (sums(c, mpm::MpmSolver<Dim>::predictedVolumeColumn(nm, a)) - sums(c, nm + a)) / volume;
+      const double mass = sums(c, a);
+      rho(c, m) = mass / volume;
+      theta(c, m) = scale * sums(c, nm + a) / volume;
+      solid = solid || rho(c, m) != 0.0 || theta(c, m) != 0.0;
+      for (int d = 0; d < Dim; ++d) {
+        const double velocity = mass > 0 ? sums(c, 2 * nm + a * Dim + d) / mass : 0.0;
+        u(c, m * Dim + d) = velocity;
+        solid_u(c, a * Dim + d) = velocity;
+      }
     }
-    return rho(c, m) != 0.0 || theta(c, m) != 0.0;
+    return solid;
   };
   // The sums are complete on the ghosts as well, so every local cell is set without a halo exchange.
   Kokkos::parallel_for(
@@ -324,10 +333,7 @@ void MpmIceStep<Dim>::cellsFromParticles(CellState<Dim>& state, double dt)
         const bool at_rest_alone =
             any_stationary && stationary(c, touch) > 0.0 && sums(c, touch) == stationary(c, touch);
         if (at_rest_alone && (rows(c) & 1)) {
-          double solid_volume = 0;
-          for (int a = 0; a < nm; ++a) solid_volume += sums(c, nm + a);
-          const double scale = solid_volume > volume ? volume / solid_volume : 1.0;
-          for (int a = 0; a < nm; ++a) setStateColumns(c, scale, a);
+          setStateColumns(c);
           marked(c) = (rows(c) >> 1) & 1;
           return;
         }
@@ -343,12 +349,7 @@ void MpmIceStep<Dim>::cellsFromParticles(CellState<Dim>& state, double dt)
           }
           return;
         }
-        bool solid = false;  // (a NaN is not zero: the phases' general path reports it)
-        // The particles' domains of two solids can overlap in a cell where their particles do not
-        // (each fills its own GIMP box): the solids then share the cell in proportion.
-        double solid_volume = 0;
-        for (int a = 0; a < nm; ++a) solid_volume += sums(c, nm + a);
-        const double scale = solid_volume > volume ? volume / solid_volume : 1.0;
+        bool solid = setStateColumns(c);
         for (int a = 0; a < nm; ++a) {
           const int m = scene_index[a];
           for (int d = 0; d < Dim; ++d)
@@ -359,7 +360,6 @@ void MpmIceStep<Dim>::cellsFromParticles(CellState<Dim>& state, double dt)
               face_cover[d](c, 2 * m + side) = cover;
               solid = solid || share != 0.0 || cover != 0.0;
             }
-          solid = setStateColumns(c, scale, a) || solid;
         }
         marked(c) = solid ? 1 : 0;
         rows(c) = static_cast<unsigned char>((at_rest_alone ? 1 : 0) | (solid ? 2 : 0));

@@ -74,17 +74,23 @@ Division divisionByOpenCells(const RunState<Dim>& run, double gain)
   return result;
 }
 
-// From the per-phase costs measured on one core (doc/scaling.md, "Weights"; bench/scaling.sh): with
-// moving fluids a cell carries the whole fluid step and a particle its share of phases 1, 2, 9 and
-// 12 and of the sums between steps (the slide: 0.12-0.14 in 2-D, 0.23-0.27 in 3-D in two series of
-// runs); in a dry scene a cell carries only its nodes' share of the grid update (the granular
-// column: 11-12; not measured in 3-D, where the 2-D value is taken). With two constraints the
-// division itself does not depend on them, only the estimated imbalance that decides a move.
+namespace {
+
+// The work of one particle in units of one cell's, for the weights of a division with the
+// particles (divisionWithParticles; domain.rebalance_interval), from the per-phase costs measured
+// on one core (doc/scaling.md, "Weights"; bench/scaling.sh): with moving fluids a cell carries the
+// whole fluid step and a particle its share of phases 1, 2, 9 and 12 and of the sums between steps
+// (the slide: 0.12-0.14 in 2-D, 0.23-0.27 in 3-D in two series of runs); in a dry scene a cell
+// carries only its nodes' share of the grid update (the granular column: 11-12; not measured in
+// 3-D, where the 2-D value is taken). With two constraints the division itself does not depend on
+// them, only the estimated imbalance that decides a move.
 double particleWork(int dimension, bool fluids_move)
 {
   if (!fluids_move) return 11.0;
   return dimension == 3 ? 0.25 : 0.13;
 }
+
+}  // namespace
 
 template <int Dim>
 Redivision divisionWithParticles(const RunState<Dim>& run, double gain)

@@ -94,10 +94,6 @@ Division divisionByOpenCells(const RunState<Dim>& run, double gain);
 /// gain of 2 % pays back within 150 steps.
 inline constexpr double kRebalanceGain = 0.02;
 
-/// The work of one particle in units of one cell's, for the weights of a division with the
-/// particles (divisionWithParticles; domain.rebalance_interval).
-double particleWork(int dimension, bool fluids_move);
-
 /// The patches divided again (divideAgain) so that the cells' work (the cells rigid bodies fill
 /// weighed kClosedCellWork) and the particles' work (MpmSolver::particlesPerPatch times
 /// particleWork) are each balanced, where that lowers the estimated imbalance by more than `gain`;

@@ -106,7 +106,6 @@ std::string agreedFailure(MPI_Comm comm, const std::string& failure)
   return first == ranks ? std::string() : broadcastText(comm, first, failure);
 }
 
-
 /// What redoing the decomposition found: the estimated imbalance (loadImbalance) of the division
 /// before and after, and the patches that changed rank (0: the run kept its division).
 struct RebalanceReport {

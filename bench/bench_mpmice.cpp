@@ -2,7 +2,9 @@
 // per cell and step of the whole coupled step and per phase (Teuchos timers "mpmice: <phase>"), next
 // to the fluid step alone on the same grid in the same run (the scene without its solids: water and
 // air), and their ratio. Both run the same number of steps at the same fixed Δt, after a warm-up,
-// in alternating blocks of steps (the ratio of each block shows the host's noise).
+// in alternating blocks of steps (the ratio of each block shows the host's noise). On more than one
+// rank the coupled step runs a second time, on the division with its particles that
+// domain.rebalance_interval makes, in the same alternation.
 //
 // usage: [mpiexec -n N] bench_mpmice [steps [dt]]     (defaults 200 steps of 2e-5 s)
 #include "coupled_support.hpp"
@@ -13,6 +15,8 @@
 #include <algorithm>
 #include <iomanip>
 #include <iostream>
+#include <limits>
+#include <memory>
 
 using namespace cfdmpm;
 
@@ -137,15 +141,28 @@ int main(int argc, char** argv)
     // The two runs take their steps in alternating blocks, so that a change of the shared host's
     // speed during the run weighs on both alike; each block's ratio shows how much it moved.
     TimedRun coupled_run(scene, dt, comm), fluid_run(fluidsOnly(scene), dt, comm);
-    std::vector<double> block_ratios;
+    // On more than one rank, and where the scene does not divide with its particles itself, the
+    // coupled step also runs on the division with its particles (domain.rebalance_interval), in
+    // the same alternation: what a rebalance would gain, measured against the same fluid run.
+    std::unique_ptr<TimedRun> rebalanced_run;
+    if (comm->getSize() > 1 && !(scene.domain.rebalance_interval > 0)) {
+      Scene with_particles = scene;
+      with_particles.domain.rebalance_interval = std::numeric_limits<int>::max();
+      rebalanced_run = std::make_unique<TimedRun>(with_particles, dt, comm);
+    }
+    std::vector<double> block_ratios, rebalanced_ratios;
     for (int done = 0; done < steps; done += kBlockSteps) {
       const int block = std::min(kBlockSteps, steps - done);
-      const double local[2] = {coupled_run.block(block), fluid_run.block(block)};
-      double slowest[2] = {0, 0};
-      Teuchos::reduceAll(*comm, Teuchos::REDUCE_MAX, 2, local, slowest);
+      const double local[3] = {coupled_run.block(block), fluid_run.block(block),
+                               rebalanced_run ? rebalanced_run->block(block) : 0.0};
+      double slowest[3] = {0, 0, 0};
+      Teuchos::reduceAll(*comm, Teuchos::REDUCE_MAX, 3, local, slowest);
       block_ratios.push_back(slowest[0] / slowest[1]);
+      rebalanced_ratios.push_back(slowest[2] / slowest[1]);
     }
     std::sort(block_ratios.begin(), block_ratios.end());
+    std::sort(rebalanced_ratios.begin(), rebalanced_ratios.end());
+    const auto rebalanced = rebalanced_run ? rebalanced_run->slowest(*comm) : std::map<std::string, double>{};
     const auto coupled = coupled_run.slowest(*comm);
     const auto fluid = fluid_run.slowest(*comm);
     const double outer_coupled = coupled_run.outerPerStep(), outer_fluid = fluid_run.outerPerStep();
@@ -167,6 +184,15 @@ int main(int argc, char** argv)
       std::cout << "coupled / fluids alone (whole step): " << coupled.at("step") / fluid.at("step") << "\n"
                 << "  per block of " << kBlockSteps << " steps (the runs alternating): lowest " << block_ratios.front()
                 << ", median " << block_ratios[block_ratios.size() / 2] << ", highest " << block_ratios.back() << "\n";
+      if (rebalanced_run) {
+        std::cout << "divided with the particles (domain.rebalance_interval): coupled / fluids alone "
+                  << rebalanced.at("step") / fluid.at("step") << " (per block: median "
+                  << rebalanced_ratios[rebalanced_ratios.size() / 2] << "); us/c-s:";
+        for (const std::string& phase : phases())
+          std::cout << (phase == phases().front() ? " " : ", ") << phase << " "
+                    << 1e6 * rebalanced.at(phase) / (cells * steps);
+        std::cout << "\n";
+      }
     }
   }
   return 0;
